@@ -1,0 +1,53 @@
+/* One on-coming clutch: the model, the observer and the VFS lag, advanced
+ * one control period per wc_clutch_step. All state lives in wc_clutch_t,
+ * owned by the caller; the calibration is shared read-only. */
+#ifndef WC_CLUTCH_H
+#define WC_CLUTCH_H
+
+#include <stdint.h>
+
+#include "wc_inverse.h"
+#include "wc_model.h"
+#include "wc_status.h"
+#include "wc_torque.h"
+
+typedef struct {
+    float slip_rad_s;          /* clutch slip speed dw, signed */
+    float theta_oil_degC;      /* oil (sump) temperature */
+    float theta_housing_degC;  /* housing temperature */
+    float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 */
+} wc_step_input_t;
+
+typedef struct {
+    float current_mA;           /* VFS current command */
+    float pressure_command_Pa;  /* K * current: the pressure commanded */
+    float pressure_model_Pa;    /* pressure the lagged VFS is modelled to reach */
+    float force_command_N;      /* contact force the inverse asked for */
+    float theta_degC;           /* friction-surface temperature used this step */
+    wc_torque_t model;          /* torque model at the modelled pressure */
+    uint32_t inverse_iterations;
+    wc_status_t status;
+} wc_step_output_t;
+
+typedef struct {
+    wc_model_t model;
+    float theta_degC;           /* observer state */
+    float pressure_model_Pa;    /* VFS lag state */
+    wc_step_input_t held;       /* last valid value of each input */
+} wc_clutch_t;
+
+/* Validate cal and start the observer at theta_start_degC (the oil
+ * temperature is the usual choice). Returns the failing field, or WC_CAL_OK. */
+wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, float theta_start_degC);
+
+/* One control period:
+ *  1. each input is checked; an invalid one is replaced by its last valid
+ *     value (held) and flagged, so one bad sample changes no state with a
+ *     bad number;
+ *  2. inverse at the current temperature estimate -> current command;
+ *  3. VFS lag -> modelled pressure -> contact force -> torque model;
+ *  4. observer advanced with P = |T_model dw|.
+ * out->theta_degC is the estimate before this step's update. */
+wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out);
+
+#endif /* WC_CLUTCH_H */

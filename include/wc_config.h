@@ -1,0 +1,48 @@
+/* Build-time settings of the wet-clutch library. Override any of them by
+ * defining WC_CONFIG_HEADER="my_config.h" (included first) or -D flags. */
+#ifndef WC_CONFIG_H
+#define WC_CONFIG_H
+
+#ifdef WC_CONFIG_HEADER
+#include WC_CONFIG_HEADER
+#endif
+
+/* Assertion hook for internal invariants (never for bad input, which is
+ * reported through status codes). Route it to the integrator's fault handler. */
+#ifndef WC_ASSERT
+#define WC_ASSERT(cond) ((void)0)
+#endif
+
+/* Plausible input ranges; a value outside is rejected as implausible. */
+#ifndef WC_SLIP_MAX_rad_s
+#define WC_SLIP_MAX_rad_s 1047.2f        /* 10000 rpm */
+#endif
+#ifndef WC_THETA_MIN_degC
+#define WC_THETA_MIN_degC (-40.0f)
+#endif
+#ifndef WC_THETA_MAX_degC
+#define WC_THETA_MAX_degC 250.0f
+#endif
+#ifndef WC_FORCE_MAX_N
+#define WC_FORCE_MAX_N 100000.0f
+#endif
+#ifndef WC_TORQUE_MAX_Nm
+#define WC_TORQUE_MAX_Nm 100000.0f
+#endif
+
+/* Bisection of the inverse: stop when the force bracket is this narrow... */
+#ifndef WC_INVERSE_FORCE_TOLERANCE_N
+#define WC_INVERSE_FORCE_TOLERANCE_N 0.01f
+#endif
+/* ...or after this many halvings, so the worst case is known at compile time.
+ * 2^24 halvings of a 100 kN bracket reach 0.006 N, below the tolerance. */
+#ifndef WC_INVERSE_MAX_ITERATIONS
+#define WC_INVERSE_MAX_ITERATIONS 24u
+#endif
+
+/* Longest film table the library accepts (bounds the lookup's search). */
+#ifndef WC_FILM_MAX_NODES
+#define WC_FILM_MAX_NODES 1024u
+#endif
+
+#endif /* WC_CONFIG_H */

@@ -1,0 +1,24 @@
+/* Piston, return spring and variable-force solenoid (VFS).
+ * Piston: F_app = P A_p - F_s (zero below the spring force).
+ * VFS: steady pressure P = K i; the reached pressure lags with time constant tau. */
+#ifndef WC_HYDRAULICS_H
+#define WC_HYDRAULICS_H
+
+#include "wc_model.h"
+#include "wc_status.h"
+
+/* Piston pressure that holds contact force force_N against the spring, Pa. */
+float wc_piston_pressure_Pa(const wc_calibration_t *cal, float force_N);
+
+/* Contact force from piston pressure, N (0 below the spring preload). */
+float wc_contact_force_N(const wc_calibration_t *cal, float pressure_Pa);
+
+/* VFS current for a pressure, clamped to [vfs_current_min, vfs_current_max];
+ * WC_STATUS_CURRENT_CLAMPED when clamped (NaN gives the minimum, clamped). */
+wc_status_t wc_vfs_current_mA(const wc_calibration_t *cal, float pressure_Pa, float *current_mA);
+
+/* One control period of the VFS first-order lag towards K * current_mA,
+ * exact for a current held over the period. Returns the reached pressure, Pa. */
+float wc_vfs_lag_step(const wc_model_t *model, float pressure_reached_Pa, float current_mA);
+
+#endif /* WC_HYDRAULICS_H */

@@ -1,0 +1,64 @@
+#include "wc_clutch.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "wc_hydraulics.h"
+#include "wc_internal.h"
+#include "wc_thermal.h"
+
+wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, float theta_start_degC)
+{
+    if (clutch == NULL) { return WC_CAL_NULL; }
+    const wc_cal_error_t error = wc_model_init(&clutch->model, cal);
+    if (error != WC_CAL_OK) { return error; }
+    const float theta = wc_theta_valid(theta_start_degC) ? theta_start_degC : cal->theta1_degC;
+    clutch->theta_degC = theta;
+    clutch->pressure_model_Pa = cal->vfs_gain_Pa_per_mA * cal->vfs_current_min_mA;  /* VFS at rest */
+    clutch->held.slip_rad_s = 0.0f;
+    clutch->held.theta_oil_degC = theta;
+    clutch->held.theta_housing_degC = theta;
+    clutch->held.torque_request_Nm = 0.0f;
+    return WC_CAL_OK;
+}
+
+/* Replace each invalid input by its last valid value; remember the valid ones. */
+static wc_status_t accept_inputs(wc_step_input_t *held, const wc_step_input_t *in)
+{
+    wc_status_t status = WC_STATUS_OK;
+    if (wc_slip_valid(in->slip_rad_s)) { held->slip_rad_s = in->slip_rad_s; }
+    else { status |= WC_STATUS_SLIP_INVALID; }
+    if (wc_theta_valid(in->theta_oil_degC)) { held->theta_oil_degC = in->theta_oil_degC; }
+    else { status |= WC_STATUS_THETA_INVALID; }
+    if (wc_theta_valid(in->theta_housing_degC)) { held->theta_housing_degC = in->theta_housing_degC; }
+    else { status |= WC_STATUS_THETA_INVALID; }
+    if (wc_in_range(in->torque_request_Nm, 0.0f, WC_TORQUE_MAX_Nm)) { held->torque_request_Nm = in->torque_request_Nm; }
+    else { status |= WC_STATUS_TORQUE_INVALID; }
+    return status;
+}
+
+wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
+{
+    const wc_model_t *model = &clutch->model;
+    wc_status_t status = accept_inputs(&clutch->held, in);
+    const wc_step_input_t *u = &clutch->held;
+
+    out->theta_degC = clutch->theta_degC;
+    wc_inverse_t inv;
+    status |= wc_inverse(model, u->slip_rad_s, clutch->theta_degC, u->torque_request_Nm, &inv);
+    out->current_mA = inv.current_mA;
+    out->force_command_N = inv.force_N;
+    out->inverse_iterations = inv.iterations;
+    out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;
+
+    clutch->pressure_model_Pa = wc_vfs_lag_step(model, clutch->pressure_model_Pa, inv.current_mA);
+    out->pressure_model_Pa = clutch->pressure_model_Pa;
+    const float force_N = wc_contact_force_N(model->cal, clutch->pressure_model_Pa);
+    status |= wc_torque(model, u->slip_rad_s, clutch->theta_degC, force_N, &out->model);
+
+    /* eq. 1 heat input: friction power |T dw| */
+    const float power_W = fabsf(out->model.torque_Nm * u->slip_rad_s);
+    status |= wc_thermal_step(model, &clutch->theta_degC, power_W, u->theta_oil_degC, u->theta_housing_degC);
+    out->status = status;
+    return status;
+}

@@ -1,0 +1,57 @@
+#include "wc_torque.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "wc_film.h"
+#include "wc_friction.h"
+#include "wc_internal.h"
+#include "wc_torque_point.h"
+#include "wc_viscosity.h"
+
+void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point)
+{
+    const wc_calibration_t *cal = model->cal;
+    const float speed_m_s = model->effective_radius_m * fabsf(slip_rad_s);                  /* eq. 4 */
+    point->mu_f = wc_friction_coefficient(cal, speed_m_s, theta_degC);                     /* eq. 18 */
+    point->coulomb_Nm_per_N = model->torque_arm_m * point->mu_f;                            /* eq. 6 */
+    point->viscous_Nm_m = model->torque_arm_m * wc_viscosity_Pa_s(cal, theta_degC) *        /* eq. 2, 7 */
+                          cal->friction_area_m2 * speed_m_s;
+}
+
+float wc_torque_point_magnitude(const wc_model_t *model, const wc_torque_point_t *point, float force_N,
+                                float *hbar_m)
+{
+    /* eq. 16: steady film, p_c = F_c / A_f */
+    const float hbar = wc_film_hbar_m(&model->cal->film, force_N / model->cal->friction_area_m2);
+    *hbar_m = hbar;
+    return point->coulomb_Nm_per_N * force_N + point->viscous_Nm_m / hbar;                  /* eq. 8 */
+}
+
+wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_degC, float force_N,
+                      wc_torque_t *out)
+{
+    wc_status_t status = WC_STATUS_OK;
+    if (!wc_slip_valid(slip_rad_s)) { status |= WC_STATUS_SLIP_INVALID; }
+    if (!wc_theta_valid(theta_degC)) { status |= WC_STATUS_THETA_INVALID; }
+    if (!wc_in_range(force_N, 0.0f, WC_FORCE_MAX_N)) { status |= WC_STATUS_FORCE_INVALID; }
+    if (status != WC_STATUS_OK) {
+        out->torque_Nm = 0.0f;
+        out->coulomb_Nm = 0.0f;
+        out->viscous_Nm = 0.0f;
+        out->hbar_m = model->cal->film.hbar_m[0];
+        out->mu_f = 0.0f;
+        return status;
+    }
+    wc_torque_point_t point;
+    wc_torque_point(model, slip_rad_s, theta_degC, &point);
+    float hbar_m = 0.0f;
+    (void)wc_torque_point_magnitude(model, &point, force_N, &hbar_m);
+    const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
+    out->coulomb_Nm = sign * point.coulomb_Nm_per_N * force_N;   /* eq. 6 */
+    out->viscous_Nm = sign * point.viscous_Nm_m / hbar_m;        /* eq. 7 */
+    out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;          /* eq. 5 */
+    out->hbar_m = hbar_m;
+    out->mu_f = point.mu_f;
+    return WC_STATUS_OK;
+}

@@ -1,0 +1,10 @@
+#include "wc_viscosity.h"
+
+#include <math.h>
+
+float wc_viscosity_Pa_s(const wc_calibration_t *cal, float theta_degC)
+{
+    /* eq. 2 */
+    return cal->viscosity_a1_Pa_s * expf(cal->viscosity_b1_per_K * theta_degC) +
+           cal->viscosity_a2_Pa_s * expf(cal->viscosity_b2_per_K * theta_degC);
+}

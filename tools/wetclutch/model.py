@@ -1,0 +1,200 @@
+"""Double-precision reference of the control model (DESIGN.md section 2).
+
+Independent of the firmware: NumPy/SciPy in float64, vectorized, with the
+film thickness solved exactly (no table). Equation numbers are the paper's.
+Units: SI, temperatures in degC, slip speed in rpm at the interfaces.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import erf, erfc
+
+from .calibration import Calibration
+
+RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+
+# Status bits shared with the firmware (include/wc_status.h).
+STATUS_BELOW_DRAG = 1 << 0        # request below the drag at zero force: force 0
+STATUS_SATURATED = 1 << 1         # request above the capacity at maximum current
+STATUS_CURRENT_CLAMPED = 1 << 2   # current clamped to the solenoid range
+
+
+def viscosity_Pa_s(cal: Calibration, theta_degC):
+    """mu_v(theta), eq. 2."""
+    th = np.asarray(theta_degC, dtype=float)
+    return cal.mv1 * np.exp(cal.mv2 * th) + cal.mv3 * np.exp(cal.mv4 * th)
+
+
+def friction_coefficient(cal: Calibration, speed_m_s, theta_degC):
+    """mu_f(v, theta), eq. 18 (Stribeck exponential x linear temperature)."""
+    v = np.abs(np.asarray(speed_m_s, dtype=float))
+    th = np.asarray(theta_degC, dtype=float)
+    stribeck = cal.mu1 + (cal.mu2 - cal.mu1) * np.exp(-v / cal.stribeck_speed)
+    return stribeck * (1.0 + cal.mu3 * (th - cal.theta1) / cal.theta2)
+
+
+def contact_pressure_Pa(cal: Calibration, separation_m):
+    """p_c(h), eq. 15 (Greenwood-Williamson with eq. 11-14)."""
+    h = np.asarray(separation_m, dtype=float)
+    s = cal.roughness_rms
+    x = h / (math.sqrt(2.0) * s)
+    k = math.sqrt(math.pi / 2.0) * cal.youngs_modulus * cal.roughness_parameter
+    return k * (np.exp(-x * x) - (h / s) * math.sqrt(math.pi / 2.0) * erfc(x))
+
+
+def film_thickness_m(cal: Calibration, separation_m):
+    """h_bar(h), eq. 9 (Patir-Cheng average film thickness)."""
+    h = np.asarray(separation_m, dtype=float)
+    s = cal.roughness_rms
+    x = h / (math.sqrt(2.0) * s)
+    return h / 2.0 * (1.0 + erf(x)) + s / math.sqrt(2.0 * math.pi) * np.exp(-x * x)
+
+
+def film_slope_m_per_Pa(cal: Calibration, separation_m):
+    """d h_bar / d p_c = (d h_bar/dh) / (d p_c/dh), exact, from eq. 9 and 15.
+
+    d h_bar/dh = (1 + erf x)/2 and d p_c/dh = -(pi/2) E N beta erfc x.
+    """
+    h = np.asarray(separation_m, dtype=float)
+    x = h / (math.sqrt(2.0) * cal.roughness_rms)
+    enb = cal.youngs_modulus * cal.asperity_density * cal.asperity_tip_radius
+    return -(1.0 + erf(x)) / (math.pi * enb * erfc(x))
+
+
+def separation_from_pressure_m(cal: Calibration, pressure_Pa):
+    """Inverse of eq. 15 by vectorized bisection (p_c is strictly decreasing in h)."""
+    p = np.asarray(pressure_Pa, dtype=float)
+    s = cal.roughness_rms
+    lo = np.full(p.shape, -60.0 * s)
+    hi = np.full(p.shape, 60.0 * s)
+    for _ in range(200):  # interval shrinks to below 1e-50 m: exact in double
+        mid = 0.5 * (lo + hi)
+        above = contact_pressure_Pa(cal, mid) > p
+        lo = np.where(above, mid, lo)
+        hi = np.where(above, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def film_domain(cal: Calibration):
+    """(separation_min_m, separation_max_m, pressure_min_Pa, pressure_max_Pa) of the modelled film.
+
+    Outside it the film is clamped (eq. 16 steady state): below pressure_min
+    (an open clutch) h_bar = h_bar(separation_max); above pressure_max the table end.
+    """
+    h_max = cal.separation_max_sigma * cal.roughness_rms
+    p_max = cal.contact_pressure_max
+    h_min = float(separation_from_pressure_m(cal, np.array([p_max]))[0])
+    p_min = float(contact_pressure_Pa(cal, h_max))
+    return h_min, h_max, p_min, p_max
+
+
+def hbar_from_pressure_m(cal: Calibration, pressure_Pa):
+    """h_bar(p_c) exactly (eq. 9 at the h solving eq. 15), clamped to the film domain."""
+    _, _, p_min, p_max = film_domain(cal)
+    p = np.clip(np.asarray(pressure_Pa, dtype=float), p_min, p_max)
+    return film_thickness_m(cal, separation_from_pressure_m(cal, p))
+
+
+def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N):
+    """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
+
+    Torques carry the sign of the slip speed (slip >= 0 counts as positive):
+    the torque transmitted through the slipping clutch, which acts against
+    the slip on the faster member. At zero slip the Coulomb part is the
+    static capacity mu_f(0, theta) F_c R_eff N_c and the viscous part is 0.
+    """
+    slip = np.asarray(slip_rpm, dtype=float)
+    force = np.asarray(force_N, dtype=float)
+    theta = np.asarray(theta_degC, dtype=float)
+    sign = np.where(slip < 0.0, -1.0, 1.0)
+    speed = cal.effective_radius * np.abs(slip) * RAD_S_PER_RPM          # eq. 4
+    mu_f = friction_coefficient(cal, speed, theta)                       # eq. 18
+    hbar = hbar_from_pressure_m(cal, force / cal.friction_area)           # eq. 9, 15, 16
+    rn = cal.effective_radius * cal.friction_pairs
+    coulomb = rn * mu_f * force                                          # eq. 6
+    viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / hbar  # eq. 7
+    return {
+        "torque_Nm": sign * (coulomb + viscous),                         # eq. 5, 8
+        "coulomb_Nm": sign * coulomb,
+        "viscous_Nm": sign * viscous,
+        "hbar_m": hbar,
+        "mu_f": mu_f,
+    }
+
+
+def force_max_N(cal: Calibration) -> float:
+    """Contact force at the solenoid's maximum current: K i_max A_p - F_s."""
+    return max(cal.vfs_gain * cal.vfs_current_max * cal.piston_area - cal.return_spring_force, 0.0)
+
+
+def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
+    """Torque request (magnitude, Nm) -> contact force -> piston pressure -> VFS current.
+
+    Returns a dict: force_N, pressure_Pa, current_mA, status (bits above).
+    The force solves |T(F)| = request exactly (vectorized bisection in double).
+    """
+    slip = np.abs(np.asarray(slip_rpm, dtype=float))
+    theta = np.asarray(theta_degC, dtype=float)
+    req = np.asarray(torque_Nm, dtype=float)
+    slip, theta, req = np.broadcast_arrays(slip, theta, req)
+    f_max = force_max_N(cal)
+
+    def mag(force):
+        return np.abs(torque_parts(cal, slip, theta, force)["torque_Nm"])
+
+    drag = mag(np.zeros(req.shape))
+    cap = mag(np.full(req.shape, f_max))
+    lo = np.zeros(req.shape)
+    hi = np.full(req.shape, f_max)
+    for _ in range(80):  # f_max / 2^80: exact in double
+        mid = 0.5 * (lo + hi)
+        low = mag(mid) < req
+        lo = np.where(low, mid, lo)
+        hi = np.where(low, hi, mid)
+    force = 0.5 * (lo + hi)
+    status = np.zeros(req.shape, dtype=int)
+    below = req <= drag
+    above = req > cap
+    force = np.where(below, 0.0, np.where(above, f_max, force))
+    status |= np.where(below, STATUS_BELOW_DRAG, 0)
+    status |= np.where(above, STATUS_SATURATED, 0)
+    pressure = (force + cal.return_spring_force) / cal.piston_area   # F_app = P A_p - F_s
+    current = pressure / cal.vfs_gain                                 # P = K i
+    clamped = (current < cal.vfs_current_min) | (current > cal.vfs_current_max)
+    current = np.clip(current, cal.vfs_current_min, cal.vfs_current_max)
+    status |= np.where(clamped, STATUS_CURRENT_CLAMPED, 0)
+    return {"force_N": force, "pressure_Pa": pressure, "current_mA": current, "status": status}
+
+
+def thermal_decay(cal: Calibration, dt_s: float) -> float:
+    """a = exp(-(k1 + k2) dt / C): the exact ZOH discretization of eq. 1."""
+    return math.exp(-(cal.oil_conductance + cal.housing_conductance) * dt_s / cal.heat_capacity)
+
+
+def thermal_steady_degC(cal: Calibration, power_W, theta_oil_degC, theta_housing_degC):
+    """Steady-state temperature of eq. 1 for constant inputs."""
+    k1, k2 = cal.oil_conductance, cal.housing_conductance
+    return (np.asarray(power_W) + k1 * np.asarray(theta_oil_degC)
+            + k2 * np.asarray(theta_housing_degC)) / (k1 + k2)
+
+
+def thermal_observer(cal: Calibration, slip_rpm, torque_Nm, theta_oil_degC, theta_housing_degC,
+                     theta_start_degC=None):
+    """Eq. 1 over a series of control periods, exact for inputs held over each period.
+
+    Row k's inputs are held from step k to k+1. Returns theta[k], the estimate
+    before row k is applied; theta[0] is theta_start (default: first oil temperature).
+    Heat input P = |T dw| (W).
+    """
+    slip = np.asarray(slip_rpm, dtype=float)
+    power = np.abs(np.asarray(torque_Nm, dtype=float) * slip * RAD_S_PER_RPM)
+    steady = thermal_steady_degC(cal, power, theta_oil_degC, theta_housing_degC)
+    a = thermal_decay(cal, cal.period)
+    out = np.empty(slip.shape)
+    theta = float(np.asarray(theta_oil_degC, dtype=float).flat[0]) if theta_start_degC is None else theta_start_degC
+    for k in range(slip.size):
+        out[k] = theta
+        theta = steady[k] + (theta - steady[k]) * a
+    return out

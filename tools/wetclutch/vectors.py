@@ -1,0 +1,80 @@
+"""Golden test vectors for the C tests (``wetclutch vectors``), from the reference."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import model, reference
+from .calibration import Calibration
+from .lut import banner
+
+SLIP_RPM = (-750.0, 0.0, 0.5, 3.0, 12.0, 50.0, 100.0, 300.0, 750.0, 1500.0, 3000.0)
+THETA_DEGC = (10.0, 25.0, 40.0, 65.0, 90.0, 120.0)
+FORCE_N = (0.0, 1.0, 50.0, 300.0, 903.0, 1188.0, 1613.0, 2200.0, 3000.0)
+TORQUE_NM = (0.0, 2.0, 10.0, 40.0, 100.0, 150.0, 300.0, 600.0, 1500.0, 4000.0, 20000.0)
+
+
+def _grid(*axes):
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return [m.ravel() for m in mesh]
+
+
+def thermal_profile(cal: Calibration):
+    """A 3 s series: slip and torque steps, oil and housing steps, one row per period."""
+    n = int(round(3.0 / cal.period))
+    t = np.arange(n) * cal.period
+    slip = np.where(t < 0.5, 0.0, np.where(t < 1.5, 750.0 - 500.0 * (t - 0.5), np.where(t < 2.2, 300.0, -100.0)))
+    torque = np.where(t < 0.5, 0.0, np.where(t < 2.2, 150.0, 60.0))
+    oil = np.where(t < 1.0, 40.0, 45.0)
+    housing = np.where(t < 2.0, 38.0, 42.0)
+    return {"t_s": t, "slip_rpm": slip, "torque_Nm": torque, "theta_oil_degC": oil, "theta_housing_degC": housing}
+
+
+def _c_double(x: float) -> str:
+    return f"{x:.9g}" if math.isfinite(x) else "NAN"
+
+
+def _table(name: str, ctype: str, cols: dict, order) -> str:
+    rows = []
+    for k in range(next(iter(cols.values())).size):
+        rows.append("    {" + ", ".join(
+            str(int(cols[c][k])) if c == "status" else _c_double(float(cols[c][k])) for c in order) + "},")
+    return (f"/* {', '.join(order)} */\nstatic const {ctype} {name}[] = {{\n" + "\n".join(rows) + "\n};\n")
+
+
+def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
+    slip, theta, force = _grid(SLIP_RPM, THETA_DEGC, FORCE_N)
+    tin = {"slip_rpm": slip, "theta_degC": theta, "force_N": force}
+    tout = reference.torque(cal, tin)
+    slip, theta, req = _grid(SLIP_RPM, THETA_DEGC, TORQUE_NM)
+    iin = {"slip_rpm": slip, "theta_degC": theta, "torque_Nm": req}
+    iout = reference.inverse(cal, iin)
+    thin = thermal_profile(cal)
+    thout = reference.thermal(cal, thin)
+    text = (
+        banner(command)
+        + f"/* Golden vectors from the double-precision reference (tools/wetclutch/model.py),\n"
+        f" * calibration {Path(cal.path).name}. Values rounded to 9 significant digits. */\n"
+        "#ifndef WC_GOLDEN_VECTORS_H\n#define WC_GOLDEN_VECTORS_H\n\n"
+        "typedef struct { double slip_rpm, theta_degC, force_N, torque_Nm, coulomb_Nm, viscous_Nm, hbar_um, mu_f; }"
+        " wc_golden_torque_t;\n"
+        "typedef struct { double slip_rpm, theta_degC, torque_Nm, force_N, pressure_kPa, current_mA; int status; }"
+        " wc_golden_inverse_t;\n"
+        "typedef struct { double t_s, slip_rpm, torque_Nm, theta_oil_degC, theta_housing_degC, theta_degC; }"
+        " wc_golden_thermal_t;\n\n"
+        + _table("wc_golden_torque", "wc_golden_torque_t", {**tin, **tout},
+                 ("slip_rpm", "theta_degC", "force_N", "torque_Nm", "coulomb_Nm", "viscous_Nm", "hbar_um", "mu_f"))
+        + "\n" + _table("wc_golden_inverse", "wc_golden_inverse_t", {**iin, **iout},
+                        ("slip_rpm", "theta_degC", "torque_Nm", "force_N", "pressure_kPa", "current_mA", "status"))
+        + "\n" + _table("wc_golden_thermal", "wc_golden_thermal_t", {**thin, **thout},
+                        ("t_s", "slip_rpm", "torque_Nm", "theta_oil_degC", "theta_housing_degC", "theta_degC"))
+        + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
+    )
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = out_dir / "wc_golden_vectors.h"
+    tmp = path.with_suffix(".h.tmp")
+    tmp.write_text(text, newline="\n")
+    tmp.replace(path)
+    return [str(path)]
