@@ -128,6 +128,8 @@ def load(path: str | Path) -> Calibration:
         raise CalibrationError(f"{path}: cannot read calibration file: {e.strerror}") from None
     except tomllib.TOMLDecodeError as e:
         raise CalibrationError(f"{path}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {e.start}): not a calibration file") from None
 
     known = {(s, n) for s, n, *_ in PARAMETERS}
     for section, table in doc.items():
