@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# All tests: installs what is missing, builds the host (sanitized) and the
+# Cortex-M4F presets, runs the C unit tests (ctest) and the Python tests (pytest).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+cd "$repo"
+bash scripts/setup.sh
+
+echo "== build: host-debug (address + undefined sanitizers)"
+cmake --preset host-debug >/dev/null
+cmake --build --preset host-debug
+
+echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
+bash scripts/check_arm.sh
+
+echo "== C unit tests (ctest)"
+ctest --test-dir build/host-debug --output-on-failure
+
+echo "== Python tests (pytest)"
+export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
+exec .venv/bin/python -m pytest tests/python -ra
