@@ -1,0 +1,118 @@
+/* E2E protection: CRC-8 SAE J1850 and alive counter. See wc_e2e.h. */
+#include "wc_e2e.h"
+
+/* One byte into the (non-reflected) CRC-8 register, bitwise: 8 steps. */
+static uint8_t crc8_j1850_update(uint8_t crc, uint8_t byte)
+{
+    uint8_t reg = (uint8_t)(crc ^ byte);
+    unsigned bit;
+
+    for (bit = 0u; bit < 8u; ++bit) {
+        if ((reg & 0x80u) != 0u) {
+            reg = (uint8_t)((uint8_t)(reg << 1) ^ WC_E2E_CRC8_POLY);
+        } else {
+            reg = (uint8_t)(reg << 1);
+        }
+    }
+    return reg;
+}
+
+uint8_t wc_e2e_crc8_j1850(const uint8_t *data, size_t len)
+{
+    uint8_t crc = WC_E2E_CRC8_INIT;
+    size_t i;
+
+    if (data == NULL) {
+        len = 0u;
+    }
+    for (i = 0u; (i < WC_E2E_CRC_MAX_BYTES) && (i < len); ++i) {
+        crc = crc8_j1850_update(crc, data[i]);
+    }
+    return (uint8_t)(crc ^ WC_E2E_CRC8_XOR_OUT);
+}
+
+wc_e2e_result_t wc_e2e_frame_crc(uint32_t frame_id, const uint8_t *frame,
+                                 size_t size, uint8_t *crc)
+{
+    uint8_t reg = WC_E2E_CRC8_INIT;
+    size_t i;
+
+    if ((frame == NULL) || (crc == NULL) || (size < WC_E2E_FRAME_BYTES)) {
+        return WC_E2E_ERR_SIZE;
+    }
+    reg = crc8_j1850_update(reg, (uint8_t)(frame_id & 0xFFu)); /* data id */
+    for (i = 0u; i < WC_E2E_FRAME_BYTES; ++i) {
+        if (i != WC_E2E_CRC_BYTE) {
+            reg = crc8_j1850_update(reg, frame[i]);
+        }
+    }
+    *crc = (uint8_t)(reg ^ WC_E2E_CRC8_XOR_OUT);
+    return WC_E2E_OK;
+}
+
+wc_e2e_result_t wc_e2e_protect(uint32_t frame_id, uint8_t *frame, size_t size)
+{
+    uint8_t crc = 0u;
+    const wc_e2e_result_t result = wc_e2e_frame_crc(frame_id, frame, size, &crc);
+
+    if (result == WC_E2E_OK) {
+        frame[WC_E2E_CRC_BYTE] = crc;
+    }
+    return result;
+}
+
+wc_e2e_result_t wc_e2e_check_crc(uint32_t frame_id, const uint8_t *frame,
+                                 size_t size)
+{
+    uint8_t crc = 0u;
+    const wc_e2e_result_t result = wc_e2e_frame_crc(frame_id, frame, size, &crc);
+
+    if (result != WC_E2E_OK) {
+        return result;
+    }
+    return (frame[WC_E2E_CRC_BYTE] == crc) ? WC_E2E_OK : WC_E2E_ERR_CRC;
+}
+
+void wc_e2e_counter_init(wc_e2e_counter_state_t *state)
+{
+    if (state != NULL) {
+        state->previous = 0u;
+        state->synced = false;
+    }
+}
+
+wc_e2e_counter_result_t wc_e2e_counter_check(wc_e2e_counter_state_t *state,
+                                             uint8_t counter)
+{
+    const uint8_t received = (uint8_t)(counter & WC_E2E_COUNTER_MASK);
+    uint8_t delta;
+
+    if (state == NULL) {
+        return WC_E2E_COUNTER_WRONG_SEQUENCE;
+    }
+    if (!state->synced) {
+        state->previous = received;
+        state->synced = true;
+        return WC_E2E_COUNTER_INITIAL;
+    }
+    delta = (uint8_t)((uint8_t)(received - state->previous) & WC_E2E_COUNTER_MASK);
+    if (delta == 1u) {
+        state->previous = received;
+        return WC_E2E_COUNTER_OK;
+    }
+    if (delta == 0u) {
+        return WC_E2E_COUNTER_REPEATED;
+    }
+    state->previous = received; /* resynchronise */
+    return WC_E2E_COUNTER_WRONG_SEQUENCE;
+}
+
+bool wc_e2e_counter_accepted(wc_e2e_counter_result_t result)
+{
+    return (result == WC_E2E_COUNTER_OK) || (result == WC_E2E_COUNTER_INITIAL);
+}
+
+uint8_t wc_e2e_counter_next(uint8_t counter)
+{
+    return (uint8_t)((uint8_t)(counter + 1u) & WC_E2E_COUNTER_MASK);
+}
