@@ -11,11 +11,20 @@
 #include "wc_status.h"
 #include "wc_torque.h"
 
+/* What the solenoid is asked to do. Torque control is 0, the default of a
+ * zero-initialized input. */
+typedef enum {
+    WC_MODE_TORQUE = 0,  /* invert the model to deliver torque_request_Nm */
+    WC_MODE_OPEN = 1,    /* minimum current: clutch released (also the safe state) */
+    WC_MODE_LOCKED = 2   /* maximum current: clutch locked */
+} wc_clutch_mode_t;
+
 typedef struct {
     float slip_rad_s;          /* clutch slip speed dw, signed */
     float theta_oil_degC;      /* oil (sump) temperature */
     float theta_housing_degC;  /* housing temperature */
-    float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 */
+    float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
+    wc_clutch_mode_t mode;
 } wc_step_input_t;
 
 typedef struct {
@@ -44,7 +53,10 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *  1. each input is checked; an invalid one is replaced by its last valid
  *     value (held) and flagged, so one bad sample changes no state with a
  *     bad number;
- *  2. inverse at the current temperature estimate -> current command;
+ *  2. WC_MODE_TORQUE: inverse at the current temperature estimate -> current
+ *     command; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
+ *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
+ *     WC_STATUS_TORQUE_INVALID);
  *  3. VFS lag -> modelled pressure -> contact force -> torque model;
  *  4. observer advanced with P = |T_model dw|.
  * out->theta_degC is the estimate before this step's update. */

@@ -19,6 +19,7 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
     clutch->held.theta_oil_degC = theta;
     clutch->held.theta_housing_degC = theta;
     clutch->held.torque_request_Nm = 0.0f;
+    clutch->held.mode = WC_MODE_OPEN;
     return WC_CAL_OK;
 }
 
@@ -45,7 +46,16 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 
     out->theta_degC = clutch->theta_degC;
     wc_inverse_t inv;
-    status |= wc_inverse(model, u->slip_rad_s, clutch->theta_degC, u->torque_request_Nm, &inv);
+    if (in->mode == WC_MODE_TORQUE) {
+        status |= wc_inverse(model, u->slip_rad_s, clutch->theta_degC, u->torque_request_Nm, &inv);
+    } else {
+        if (in->mode != WC_MODE_LOCKED && in->mode != WC_MODE_OPEN) { status |= WC_STATUS_TORQUE_INVALID; }
+        const wc_calibration_t *cal = model->cal;
+        inv.current_mA = (in->mode == WC_MODE_LOCKED) ? cal->vfs_current_max_mA : cal->vfs_current_min_mA;
+        inv.force_N = wc_contact_force_N(cal, cal->vfs_gain_Pa_per_mA * inv.current_mA);
+        inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
+        inv.iterations = 0u;
+    }
     out->current_mA = inv.current_mA;
     out->force_command_N = inv.force_N;
     out->inverse_iterations = inv.iterations;

@@ -1,0 +1,110 @@
+/* The CAN frame loop of one clutch: portable (no OS calls), fixed-size
+ * receive ring, E2E checks, input freshness, one model step per period and
+ * the two output frames. The frames and their scaling are those of
+ * hil/wetclutch.dbc (codec in src/can/).
+ *
+ * Safe-state policy (also in README.md):
+ *  - A received frame is used only if its length, CRC and alive counter are
+ *    right and every signal is plausible (inside its DBC range, not SNA, Mode
+ *    not reserved). Otherwise it is dropped and counted by reason; CRC,
+ *    counter and implausible rejections set StatusCrcError /
+ *    StatusCounterError / StatusImplausibleInput in the next VfsCommand.
+ *  - Between valid frames the last valid value of each input is held.
+ *  - An input with no valid frame for its timeout (default 10 periods = 10 ms)
+ *    is stale: StatusSensorTimeout or StatusRequestTimeout, plus
+ *    StatusSafeStateActive, and the safe output: the solenoid's minimum
+ *    current (clutch released: an element that cannot be controlled is opened;
+ *    the transmission's limp-home strategy is the integrator's). The observer
+ *    keeps running on the held temperatures with the released clutch.
+ *  - The first valid frame after a timeout (its counter is taken as the new
+ *    reference) ends the safe state for that input.
+ *  - Before the first valid frame of each input the loop is in the safe state.
+ */
+#ifndef WC_LOOP_H
+#define WC_LOOP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "wc_can_frame.h"
+#include "wc_can_scaling.h"
+#include "wc_clutch.h"
+#include "wc_e2e.h"
+
+#define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */
+#define WC_LOOP_TX_FRAMES 2u      /* VfsCommand, ClutchEstimate */
+
+typedef struct {
+    uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit */
+    uint32_t request_timeout_periods;  /* TorqueRequest freshness limit */
+} wc_loop_config_t;
+
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u }
+
+typedef enum {
+    WC_REJECT_CRC = 0,      /* E2E CRC mismatch */
+    WC_REJECT_COUNTER,      /* alive counter repeated or jumped */
+    WC_REJECT_SHORT,        /* DLC below 8 */
+    WC_REJECT_UNKNOWN_ID,   /* not a frame the TCU receives */
+    WC_REJECT_FORMAT,       /* extended id, remote or error frame */
+    WC_REJECT_IMPLAUSIBLE,  /* signal SNA, out of DBC range, or reserved Mode */
+    WC_REJECT_OVERFLOW,     /* receive ring full: frame lost before the step */
+    WC_REJECT_REASONS
+} wc_loop_reject_t;
+
+typedef struct {
+    uint32_t frames_in;                     /* frames offered to wc_loop_receive */
+    uint32_t frames_used;                   /* frames that passed every check */
+    uint32_t frames_out;                    /* frames produced by wc_loop_step */
+    uint32_t rejected[WC_REJECT_REASONS];
+    uint32_t sensor_timeouts;               /* fresh -> stale transitions */
+    uint32_t request_timeouts;
+    uint32_t safe_steps;                    /* steps spent in the safe state */
+    uint32_t steps;
+    uint32_t deadline_misses;               /* reported by the port */
+} wc_loop_counters_t;
+
+typedef struct {
+    uint32_t age_periods;           /* periods since the last valid frame */
+    bool seen;                      /* a valid frame since init or timeout */
+    bool stale;
+    wc_e2e_counter_state_t alive;
+} wc_loop_input_t;
+
+typedef struct {
+    wc_clutch_t clutch;
+    wc_loop_config_t config;
+    wc_can_frame_t rx[WC_LOOP_RX_CAPACITY];
+    uint32_t rx_head;
+    uint32_t rx_count;
+    wc_loop_input_t sensors_in;
+    wc_loop_input_t request_in;
+    wc_can_clutch_sensors_phys_t sensors;   /* last valid */
+    wc_can_torque_request_phys_t request;   /* last valid */
+    uint16_t pending_status;                /* event bits for the next VfsCommand */
+    uint8_t tx_alive;
+    wc_loop_counters_t counters;
+    wc_step_output_t last;                  /* last step's model output */
+} wc_loop_t;
+
+/* Validate the calibration and start in the safe state (no input seen). */
+wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
+                            float theta_start_degC);
+
+/* Queue one received frame for the next step. Returns false (and counts
+ * WC_REJECT_OVERFLOW) when the ring is full. */
+bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame);
+
+/* The port missed `missed` step deadlines: counted, flagged in the next VfsCommand. */
+void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed);
+
+/* One control period: process the queued frames, update freshness, step the
+ * model, and write the output frames (VfsCommand, ClutchEstimate) to out.
+ * Returns the number of frames written (WC_LOOP_TX_FRAMES). */
+uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
+
+/* Receive filter ids for the port (the frames wc_loop_receive uses). */
+#define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID }
+#define WC_LOOP_RX_ID_COUNT 2u
+
+#endif /* WC_LOOP_H */

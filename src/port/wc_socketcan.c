@@ -1,0 +1,128 @@
+#define _GNU_SOURCE
+#include "wc_socketcan.h"
+
+#include <errno.h>
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <poll.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#define WC_SOCKETCAN_MAX_FILTERS 16u
+
+static int fail(wc_socketcan_t *port, const char *what, int err, const char *hint)
+{
+    (void)snprintf(port->error, sizeof port->error, "%s: %s%s%s", what, strerror(err), hint[0] ? "; " : "", hint);
+    return -1;
+}
+
+int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *filter_ids, size_t count)
+{
+    port->fd = -1;
+    port->error[0] = '\0';
+    if (strlen(iface) >= IFNAMSIZ) {
+        return fail(port, "interface name too long", ENAMETOOLONG, "");
+    }
+    const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+    if (fd < 0) {
+        const int err = errno;
+        return fail(port, "socket(PF_CAN, SOCK_RAW, CAN_RAW)", err,
+                    (err == EAFNOSUPPORT)
+                        ? "this kernel has no CAN support (CONFIG_CAN); run inside the VM: bash hil/vcan_run.sh -- <command>"
+                        : "");
+    }
+    struct ifreq ifr;
+    memset(&ifr, 0, sizeof ifr);
+    (void)snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", iface);
+    if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
+        const int err = errno;
+        char hint[200];
+        (void)snprintf(hint, sizeof hint,
+                       "create it: modprobe vcan && ip link add dev %s type vcan && ip link set up %s", iface, iface);
+        (void)close(fd);
+        return fail(port, iface, err, hint);
+    }
+    if (count > WC_SOCKETCAN_MAX_FILTERS) {
+        (void)close(fd);
+        return fail(port, "too many receive filters", EINVAL, "");
+    }
+    struct can_filter filters[WC_SOCKETCAN_MAX_FILTERS];
+    for (size_t i = 0; i < count; ++i) {
+        filters[i].can_id = filter_ids[i] & CAN_SFF_MASK;
+        filters[i].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
+    }
+    if (setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters, (socklen_t)(count * sizeof filters[0])) < 0) {
+        const int err = errno;
+        (void)close(fd);
+        return fail(port, "setsockopt(CAN_RAW_FILTER)", err, "");
+    }
+    struct sockaddr_can addr;
+    memset(&addr, 0, sizeof addr);
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = ifr.ifr_ifindex;
+    if (bind(fd, (struct sockaddr *)&addr, sizeof addr) < 0) {
+        const int err = errno;
+        (void)close(fd);
+        return fail(port, "bind", err, "is the interface up? ip link set up <iface>");
+    }
+    port->fd = fd;
+    return 0;
+}
+
+int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t timeout_us)
+{
+    struct pollfd pfd = { .fd = port->fd, .events = POLLIN, .revents = 0 };
+    struct timespec timeout = { .tv_sec = (time_t)(timeout_us / 1000000), .tv_nsec = (long)(timeout_us % 1000000) * 1000L };
+    const int ready = ppoll(&pfd, 1, (timeout_us < 0) ? NULL : &timeout, NULL);  /* ns resolution, unlike poll */
+    if (ready < 0) {
+        if (errno == EINTR) { return 0; }
+        return fail(port, "poll", errno, "");
+    }
+    if (ready == 0) { return 0; }
+    struct can_frame raw;
+    const ssize_t n = read(port->fd, &raw, sizeof raw);
+    if (n < 0) {
+        if ((errno == EINTR) || (errno == EAGAIN)) { return 0; }
+        return fail(port, "read", errno, "");
+    }
+    memset(frame, 0, sizeof *frame);
+    if ((size_t)n < sizeof raw) {  /* never from a CAN_RAW socket, but never trust a length */
+        frame->dlc = 0;
+        frame->flags = WC_CAN_FLAG_ERROR;
+        return 1;
+    }
+    frame->flags = (uint8_t)(((raw.can_id & CAN_EFF_FLAG) ? WC_CAN_FLAG_EXTENDED : 0u) |
+                             ((raw.can_id & CAN_RTR_FLAG) ? WC_CAN_FLAG_REMOTE : 0u) |
+                             ((raw.can_id & CAN_ERR_FLAG) ? WC_CAN_FLAG_ERROR : 0u));
+    frame->id = raw.can_id & ((raw.can_id & CAN_EFF_FLAG) ? CAN_EFF_MASK : CAN_SFF_MASK);
+    frame->dlc = (raw.len <= 8u) ? raw.len : 8u;
+    memcpy(frame->data, raw.data, frame->dlc);
+    return 1;
+}
+
+int wc_socketcan_send(wc_socketcan_t *port, const wc_can_frame_t *frame)
+{
+    struct can_frame raw;
+    memset(&raw, 0, sizeof raw);
+    raw.can_id = frame->id & CAN_SFF_MASK;
+    raw.len = (frame->dlc <= 8u) ? frame->dlc : 8u;
+    memcpy(raw.data, frame->data, raw.len);
+    const ssize_t n = write(port->fd, &raw, sizeof raw);
+    if (n != (ssize_t)sizeof raw) {
+        return fail(port, "write", (n < 0) ? errno : EIO, (errno == ENOBUFS) ? "transmit queue full" : "");
+    }
+    return 0;
+}
+
+void wc_socketcan_close(wc_socketcan_t *port)
+{
+    if (port->fd >= 0) {
+        (void)close(port->fd);
+        port->fd = -1;
+    }
+}

@@ -1,0 +1,274 @@
+/* wc_tcu: the TCU program. Runs the portable frame loop (wc_loop) of one
+ * clutch on a SocketCAN interface.
+ *   --clock timer  steps at absolute deadlines (clock_nanosleep), counts misses
+ *   --clock frame  one step per received ClutchSensors frame, so that replaying
+ *                  one log twice gives byte-identical output frames
+ * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit idle seconds) it
+ * prints frames in/out, rejects by reason, timeouts, deadline misses and the
+ * step-time max and percentiles, and optionally writes them as JSON. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <getopt.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "wc_loop.h"
+#include "wc_socketcan.h"
+#include "wc_table1_calibration.h"
+
+/* Step-time histogram: 100 ns bins up to 1 ms, one overflow bin; the max is kept exactly. */
+#define HIST_BIN_NS 100
+#define HIST_BINS 10000
+
+typedef struct {
+    uint64_t bins[HIST_BINS + 1];
+    uint64_t count;
+    int64_t max_ns;
+} step_times_t;
+
+typedef struct {
+    const char *iface;
+    const char *calibration;
+    const char *stats_json;
+    int64_t period_ns;
+    int frame_clock;
+    uint64_t max_steps;       /* 0: unlimited */
+    double idle_exit_s;       /* 0: never */
+    double theta_start_degC;
+    unsigned sensor_timeout, request_timeout;
+} options_t;
+
+static volatile sig_atomic_t stop_requested = 0;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
+
+static void record(step_times_t *h, int64_t ns)
+{
+    const int64_t bin = ns / HIST_BIN_NS;
+    h->bins[(bin < HIST_BINS) ? bin : HIST_BINS]++;
+    h->count++;
+    if (ns > h->max_ns) { h->max_ns = ns; }
+}
+
+static double percentile_us(const step_times_t *h, double p)
+{
+    if (h->count == 0) { return 0.0; }
+    const uint64_t rank = (uint64_t)(p / 100.0 * (double)(h->count - 1)) + 1;
+    uint64_t seen = 0;
+    for (int i = 0; i <= HIST_BINS; ++i) {
+        seen += h->bins[i];
+        if (seen >= rank) { return (i == HIST_BINS) ? (double)h->max_ns / 1000.0 : (i + 0.5) * HIST_BIN_NS / 1000.0; }
+    }
+    return (double)h->max_ns / 1000.0;
+}
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+            "usage: wc_tcu [options]\n"
+            "  -i, --iface NAME          SocketCAN interface (default vcan0)\n"
+            "  -c, --clock timer|frame   timer: fixed period, absolute deadlines (default);\n"
+            "                            frame: one step per ClutchSensors frame (deterministic replay)\n"
+            "  -p, --period-us N         step period for --clock timer (default: the calibration's, 1000)\n"
+            "  -k, --calibration NAME    compiled-in calibration (available: table1)\n"
+            "  -n, --steps N             stop after N steps (default: run until SIGINT/SIGTERM)\n"
+            "  -I, --idle-exit S         stop after S seconds without any received frame\n"
+            "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
+            "      --sensor-timeout N    ClutchSensors timeout in periods (default 10)\n"
+            "      --request-timeout N   TorqueRequest timeout in periods (default 10)\n"
+            "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
+            "  -h, --help\n");
+}
+
+static int parse_number(const char *text, const char *option, double lo, double hi, double *value)
+{
+    char *end = NULL;
+    errno = 0;
+    const double v = strtod(text, &end);
+    if (errno != 0 || end == text || *end != '\0' || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "wc_tcu: %s: '%s' is not a number in [%g, %g]\n", option, text, lo, hi);
+        return -1;
+    }
+    *value = v;
+    return 0;
+}
+
+static int parse_options(int argc, char **argv, options_t *o)
+{
+    static const struct option longopts[] = {
+        {"iface", required_argument, NULL, 'i'},       {"clock", required_argument, NULL, 'c'},
+        {"period-us", required_argument, NULL, 'p'},   {"calibration", required_argument, NULL, 'k'},
+        {"steps", required_argument, NULL, 'n'},       {"idle-exit", required_argument, NULL, 'I'},
+        {"theta-start", required_argument, NULL, 't'}, {"stats-json", required_argument, NULL, 'j'},
+        {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
+        {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
+    *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
+                     .sensor_timeout = 10u, .request_timeout = 10u};
+    double v = 0.0;
+    int c;
+    while ((c = getopt_long(argc, argv, "i:c:p:k:n:I:t:j:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'i': o->iface = optarg; break;
+        case 'c':
+            if (strcmp(optarg, "timer") == 0) { o->frame_clock = 0; }
+            else if (strcmp(optarg, "frame") == 0) { o->frame_clock = 1; }
+            else { fprintf(stderr, "wc_tcu: --clock: '%s': use timer or frame\n", optarg); return -1; }
+            break;
+        case 'p': if (parse_number(optarg, "--period-us", 50, 1e6, &v)) { return -1; } o->period_ns = (int64_t)(v * 1000.0); break;
+        case 'k': o->calibration = optarg; break;
+        case 'n': if (parse_number(optarg, "--steps", 1, 1e12, &v)) { return -1; } o->max_steps = (uint64_t)v; break;
+        case 'I': if (parse_number(optarg, "--idle-exit", 0.001, 1e6, &v)) { return -1; } o->idle_exit_s = v; break;
+        case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
+        case 'j': o->stats_json = optarg; break;
+        case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; break;
+        case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; break;
+        case 'h': usage(stdout); exit(0);
+        default: usage(stderr); return -1;
+        }
+    }
+    if (optind < argc) { fprintf(stderr, "wc_tcu: unexpected argument '%s'\n", argv[optind]); return -1; }
+    return 0;
+}
+
+static const char *const reject_names[WC_REJECT_REASONS] = {
+    [WC_REJECT_CRC] = "crc", [WC_REJECT_COUNTER] = "counter", [WC_REJECT_SHORT] = "short",
+    [WC_REJECT_UNKNOWN_ID] = "unknown_id", [WC_REJECT_FORMAT] = "format",
+    [WC_REJECT_IMPLAUSIBLE] = "implausible", [WC_REJECT_OVERFLOW] = "overflow"};
+
+static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, const step_times_t *h)
+{
+    static const double pct[] = {50.0, 90.0, 99.0, 99.9};
+    if (json) {
+        fprintf(out, "{\n  \"frames_in\": %u,\n  \"frames_used\": %u,\n  \"frames_out\": %u,\n  \"tx_errors\": %llu,\n",
+                k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors);
+        fprintf(out, "  \"rejected\": {");
+        for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, "%s\"%s\": %u", r ? ", " : "", reject_names[r], k->rejected[r]); }
+        fprintf(out, "},\n  \"sensor_timeouts\": %u,\n  \"request_timeouts\": %u,\n  \"safe_steps\": %u,\n"
+                     "  \"steps\": %u,\n  \"deadline_misses\": %u,\n",
+                k->sensor_timeouts, k->request_timeouts, k->safe_steps, k->steps, k->deadline_misses);
+        fprintf(out, "  \"step_time_us\": {\"max\": %.3f, \"p50\": %.3f, \"p90\": %.3f, \"p99\": %.3f, \"p99.9\": %.3f}\n}\n",
+                (double)h->max_ns / 1000.0, percentile_us(h, 50), percentile_us(h, 90), percentile_us(h, 99),
+                percentile_us(h, 99.9));
+        return;
+    }
+    fprintf(out, "wc_tcu: frames in %u (used %u), out %u, send errors %llu\n", k->frames_in, k->frames_used,
+            k->frames_out, (unsigned long long)tx_errors);
+    fprintf(out, "wc_tcu: rejected:");
+    for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, " %s %u", reject_names[r], k->rejected[r]); }
+    fprintf(out, "\nwc_tcu: timeouts: sensors %u, request %u; steps %u (safe state %u); deadline misses %u\n",
+            k->sensor_timeouts, k->request_timeouts, k->steps, k->safe_steps, k->deadline_misses);
+    fprintf(out, "wc_tcu: step time (loop step + send) max %.1f us", (double)h->max_ns / 1000.0);
+    for (size_t i = 0; i < sizeof pct / sizeof pct[0]; ++i) { fprintf(out, ", p%g %.1f us", pct[i], percentile_us(h, pct[i])); }
+    fprintf(out, "\n");
+}
+
+int main(int argc, char **argv)
+{
+    options_t opt;
+    if (parse_options(argc, argv, &opt) != 0) { return 2; }
+    if (strcmp(opt.calibration, "table1") != 0) {
+        fprintf(stderr, "wc_tcu: --calibration: '%s' is not compiled in (available: table1); generate headers with"
+                        " `wetclutch lut` and rebuild\n", opt.calibration);
+        return 2;
+    }
+    static wc_loop_t loop;  /* large (receive ring): static storage, not the stack */
+    static step_times_t times;
+    const wc_loop_config_t config = {opt.sensor_timeout, opt.request_timeout};
+    const wc_cal_error_t cal_error = wc_loop_init(&loop, &wc_table1_calibration, &config, (float)opt.theta_start_degC);
+    if (cal_error != WC_CAL_OK) {
+        fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
+        return 2;
+    }
+    if (opt.period_ns == 0) { opt.period_ns = (int64_t)((double)wc_table1_calibration.control_period_s * 1e9 + 0.5); }
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    if (sigaction(SIGINT, &sa, NULL) != 0 || sigaction(SIGTERM, &sa, NULL) != 0) {
+        perror("wc_tcu: sigaction");
+        return 1;
+    }
+
+    wc_socketcan_t port;
+    const uint32_t ids[] = WC_LOOP_RX_IDS;
+    if (wc_socketcan_open(&port, opt.iface, ids, WC_LOOP_RX_ID_COUNT) != 0) {
+        fprintf(stderr, "wc_tcu: %s\n", port.error);
+        return 1;
+    }
+    fprintf(stderr, "wc_tcu: %s, clock %s, period %lld us, calibration %s\n", opt.iface,
+            opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration);
+
+    uint64_t tx_errors = 0;
+    int status = 0;
+    int64_t last_rx = now_ns();
+    int64_t deadline = now_ns() + opt.period_ns;
+    while (!stop_requested && (opt.max_steps == 0 || loop.counters.steps < opt.max_steps)) {
+        int step_now = 0;
+        wc_can_frame_t frame;
+        const int64_t wait_ns = opt.frame_clock ? 100000000LL : deadline - now_ns();
+        const int got = (wait_ns > 0) ? wc_socketcan_receive(&port, &frame, wait_ns / 1000) : 0;
+        if (got < 0) {
+            fprintf(stderr, "wc_tcu: %s\n", port.error);
+            status = 1;
+            break;
+        }
+        const int64_t t = now_ns();
+        if (got == 1) {
+            last_rx = t;
+            (void)wc_loop_receive(&loop, &frame);
+            step_now = opt.frame_clock && (frame.id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && frame.flags == 0u;
+        } else if (opt.idle_exit_s > 0 && (double)(t - last_rx) > opt.idle_exit_s * 1e9) {
+            break;
+        }
+        if (!opt.frame_clock && t >= deadline) {
+            step_now = 1;
+            deadline += opt.period_ns;
+            if (t >= deadline) {  /* late by a whole period or more: skip, count */
+                const int64_t missed = (t - deadline) / opt.period_ns + 1;
+                deadline += missed * opt.period_ns;
+                wc_loop_deadline_missed(&loop, (uint32_t)missed);
+            }
+        }
+        if (!step_now) { continue; }
+        const int64_t t0 = now_ns();
+        wc_can_frame_t out[WC_LOOP_TX_FRAMES];
+        const uint32_t n = wc_loop_step(&loop, out);
+        for (uint32_t i = 0; i < n; ++i) {
+            if (wc_socketcan_send(&port, &out[i]) != 0) {
+                if (tx_errors == 0) { fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port.error); }
+                tx_errors++;
+            }
+        }
+        record(&times, now_ns() - t0);
+    }
+    wc_socketcan_close(&port);
+    report(stderr, 0, &loop.counters, tx_errors, &times);
+    if (opt.stats_json != NULL) {
+        FILE *f = fopen(opt.stats_json, "w");
+        if (f == NULL) {
+            fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
+            return 1;
+        }
+        report(f, 1, &loop.counters, tx_errors, &times);
+        if (fclose(f) != 0) {
+            fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
+            return 1;
+        }
+    }
+    return status;
+}

@@ -1,0 +1,190 @@
+#include "wc_loop.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "wetclutch.h"
+
+static void input_reset(wc_loop_input_t *in)
+{
+    in->age_periods = 0u;
+    in->seen = false;
+    in->stale = true;
+    wc_e2e_counter_init(&in->alive);
+}
+
+wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
+                            float theta_start_degC)
+{
+    if ((loop == NULL) || (config == NULL)) { return WC_CAL_NULL; }
+    memset(loop, 0, sizeof *loop);
+    const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
+    if (error != WC_CAL_OK) { return error; }
+    loop->config = *config;
+    input_reset(&loop->sensors_in);
+    input_reset(&loop->request_in);
+    loop->sensors.oil_temp_degC = theta_start_degC;
+    loop->sensors.housing_temp_degC = theta_start_degC;
+    loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
+    return WC_CAL_OK;
+}
+
+static void reject(wc_loop_t *loop, wc_loop_reject_t reason)
+{
+    loop->counters.rejected[reason]++;
+    static const uint16_t flag[WC_REJECT_REASONS] = {
+        [WC_REJECT_CRC] = WC_CAN_STATUS_CRC_ERROR,
+        [WC_REJECT_COUNTER] = WC_CAN_STATUS_COUNTER_ERROR,
+        [WC_REJECT_IMPLAUSIBLE] = WC_CAN_STATUS_IMPLAUSIBLE_INPUT,
+    };
+    loop->pending_status = (uint16_t)(loop->pending_status | flag[reason]);
+}
+
+bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame)
+{
+    loop->counters.frames_in++;
+    if (loop->rx_count >= WC_LOOP_RX_CAPACITY) {
+        reject(loop, WC_REJECT_OVERFLOW);
+        return false;
+    }
+    loop->rx[(loop->rx_head + loop->rx_count) % WC_LOOP_RX_CAPACITY] = *frame;
+    loop->rx_count++;
+    return true;
+}
+
+void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed)
+{
+    loop->counters.deadline_misses += missed;
+    if (missed > 0u) { loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_DEADLINE_MISS); }
+}
+
+/* Map a decode result and the alive counter to use / reject. */
+static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, uint8_t alive)
+{
+    if (decoded == WC_CAN_ERR_SIZE) { reject(loop, WC_REJECT_SHORT); return false; }
+    if (decoded == WC_CAN_ERR_CRC) { reject(loop, WC_REJECT_CRC); return false; }
+    /* The counter is checked before plausibility: an implausible frame still
+     * proves the sender is alive and in sequence. */
+    if (!wc_e2e_counter_accepted(wc_e2e_counter_check(&in->alive, alive))) {
+        reject(loop, WC_REJECT_COUNTER);
+        return false;
+    }
+    if (wc_can_is_error(decoded)) { reject(loop, WC_REJECT_IMPLAUSIBLE); return false; }
+    in->age_periods = 0u;
+    in->seen = true;
+    loop->counters.frames_used++;
+    return true;
+}
+
+static void process(wc_loop_t *loop, const wc_can_frame_t *f)
+{
+    if ((f->flags & (WC_CAN_FLAG_EXTENDED | WC_CAN_FLAG_REMOTE | WC_CAN_FLAG_ERROR)) != 0u) {
+        reject(loop, WC_REJECT_FORMAT);
+        return;
+    }
+    if (f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) {
+        wc_can_clutch_sensors_phys_t s;
+        const wc_can_result_t r = wc_can_decode_clutch_sensors(&s, f->data, f->dlc);
+        if (accept(loop, &loop->sensors_in, r, s.alive_counter)) { loop->sensors = s; }
+    } else if (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID) {
+        wc_can_torque_request_phys_t q;
+        const wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
+        if (accept(loop, &loop->request_in, r, q.alive_counter)) { loop->request = q; }
+    } else {
+        reject(loop, WC_REJECT_UNKNOWN_ID);
+    }
+}
+
+/* Freshness after this period's frames; returns true when stale. */
+static bool update_freshness(wc_loop_input_t *in, uint32_t timeout_periods, uint32_t *timeouts)
+{
+    const bool stale = !in->seen || (in->age_periods >= timeout_periods);
+    if (stale && !in->stale && in->seen) {
+        (*timeouts)++;
+        in->seen = false;              /* the next valid frame restarts the input... */
+        wc_e2e_counter_init(&in->alive);  /* ...and its counter is the new reference */
+    }
+    in->stale = stale;
+    if (in->age_periods < UINT32_MAX) { in->age_periods++; }
+    return stale;
+}
+
+static wc_clutch_mode_t mode_of(uint8_t can_mode)
+{
+    switch (can_mode) {
+    case WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE: return WC_MODE_TORQUE;
+    case WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE: return WC_MODE_LOCKED;
+    default: return WC_MODE_OPEN;
+    }
+}
+
+static uint16_t status_bits(wc_status_t status)
+{
+    uint16_t bits = 0u;
+    if ((status & WC_STATUS_SATURATED) != 0u) { bits |= WC_CAN_STATUS_SATURATED; }
+    if ((status & WC_STATUS_CURRENT_CLAMPED) != 0u) { bits |= WC_CAN_STATUS_CURRENT_CLAMPED; }
+    if ((status & WC_STATUS_BELOW_DRAG) != 0u) { bits |= WC_CAN_STATUS_BELOW_DRAG; }
+    if ((status & WC_STATUS_INPUT_INVALID) != 0u) { bits |= WC_CAN_STATUS_IMPLAUSIBLE_INPUT; }
+    return bits;
+}
+
+uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (loop->rx_count > 0u); ++i) {
+        process(loop, &loop->rx[loop->rx_head]);
+        loop->rx_head = (loop->rx_head + 1u) % WC_LOOP_RX_CAPACITY;
+        loop->rx_count--;
+    }
+    uint16_t bits = loop->pending_status;
+    loop->pending_status = 0u;
+    if (update_freshness(&loop->sensors_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts)) {
+        bits |= WC_CAN_STATUS_SENSOR_TIMEOUT;
+    }
+    if (update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
+        bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
+    }
+    const bool safe = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) != 0u;
+
+    const wc_step_input_t in = {
+        .slip_rad_s = loop->sensors.slip_speed_rpm * WC_RAD_S_PER_RPM,
+        .theta_oil_degC = loop->sensors.oil_temp_degC,
+        .theta_housing_degC = loop->sensors.housing_temp_degC,
+        .torque_request_Nm = loop->request.torque_request_Nm,
+        .mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode),
+    };
+    bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
+    if (safe) {
+        bits |= WC_CAN_STATUS_SAFE_STATE_ACTIVE;
+        loop->counters.safe_steps++;
+    }
+
+    const wc_step_output_t *o = &loop->last;
+    const wc_can_clutch_estimate_phys_t estimate = {
+        .estimated_clutch_temp_degC = o->theta_degC,
+        .model_torque_Nm = o->model.torque_Nm,
+        .mu_f = o->model.mu_f,
+        .film_thickness_um = o->model.hbar_m * 1.0e6f,
+    };
+    out[1].id = WC_CAN_CLUTCH_ESTIMATE_FRAME_ID;
+    out[1].dlc = WC_CAN_CLUTCH_ESTIMATE_LENGTH;
+    out[1].flags = 0u;
+    if (wc_can_encode_clutch_estimate(out[1].data, &estimate, sizeof out[1].data) == WC_CAN_SATURATED) {
+        bits |= WC_CAN_STATUS_SATURATED;
+    }
+    const wc_can_vfs_command_phys_t command = {
+        .vfs_current_mA = o->current_mA,
+        .pressure_command_kPa = o->pressure_command_Pa * 1.0e-3f,
+        .status = bits,
+        .alive_counter = loop->tx_alive,
+    };
+    loop->tx_alive = wc_e2e_counter_next(loop->tx_alive);
+    out[0].id = WC_CAN_VFS_COMMAND_FRAME_ID;
+    out[0].dlc = WC_CAN_VFS_COMMAND_LENGTH;
+    out[0].flags = 0u;
+    (void)wc_can_encode_vfs_command(out[0].data, &command, sizeof out[0].data);
+
+    loop->counters.steps++;
+    loop->counters.frames_out += WC_LOOP_TX_FRAMES;
+    return WC_LOOP_TX_FRAMES;
+}
