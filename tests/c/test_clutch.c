@@ -1,0 +1,338 @@
+/* One clutch instance: inputs checked and held, inverse -> VFS lag -> torque
+ * model -> observer, all state in wc_clutch_t. */
+#include "wc_test_support.h"
+
+#include <float.h>
+
+#include "wc_golden_vectors.h"
+#include "wc_table1_calibration.h"
+
+#define STEPS 1500
+
+/* Torque control (the zero value of any other field, e.g. the mode). */
+static wc_step_input_t input(float slip_rad_s, float theta_oil_degC, float theta_housing_degC, float torque_Nm)
+{
+    wc_step_input_t in;
+    memset(&in, 0, sizeof in);
+    in.slip_rad_s = slip_rad_s;
+    in.theta_oil_degC = theta_oil_degC;
+    in.theta_housing_degC = theta_housing_degC;
+    in.torque_request_Nm = torque_Nm;
+    return in;
+}
+
+/* A drive cycle: slip ramps down through zero and reverses, the request
+ * steps, oil and housing drift. Row k of the input sequence. */
+static wc_step_input_t profile(int k)
+{
+    const float t = 0.001f * (float)k;
+    return input(wc_test_rpm_to_rad_s(750.0 - 1000.0 * (double)t),  /* 750 -> -750 rpm */
+                 40.0f + 5.0f * t, 38.0f + 2.0f * t, (k < 300) ? 0.0f : ((k < 900) ? 150.0f : 60.0f));
+}
+
+static bool finite_output(const wc_step_output_t *out)
+{
+    return isfinite(out->current_mA) && isfinite(out->pressure_command_Pa) && isfinite(out->pressure_model_Pa) &&
+           isfinite(out->force_command_N) && isfinite(out->theta_degC) && isfinite(out->model.torque_Nm) &&
+           isfinite(out->model.coulomb_Nm) && isfinite(out->model.viscous_Nm) && isfinite(out->model.hbar_m) &&
+           isfinite(out->model.mu_f);
+}
+
+/* Every output but the status, bit for bit. */
+static bool same_output(const wc_step_output_t *a, const wc_step_output_t *b)
+{
+    return wc_test_same_float(a->current_mA, b->current_mA) &&
+           wc_test_same_float(a->pressure_command_Pa, b->pressure_command_Pa) &&
+           wc_test_same_float(a->pressure_model_Pa, b->pressure_model_Pa) &&
+           wc_test_same_float(a->force_command_N, b->force_command_N) &&
+           wc_test_same_float(a->theta_degC, b->theta_degC) &&
+           wc_test_same_float(a->model.torque_Nm, b->model.torque_Nm) &&
+           wc_test_same_float(a->model.coulomb_Nm, b->model.coulomb_Nm) &&
+           wc_test_same_float(a->model.viscous_Nm, b->model.viscous_Nm) &&
+           wc_test_same_float(a->model.hbar_m, b->model.hbar_m) && wc_test_same_float(a->model.mu_f, b->model.mu_f) &&
+           (a->inverse_iterations == b->inverse_iterations);
+}
+
+static bool same_state(const wc_clutch_t *a, const wc_clutch_t *b)
+{
+    return wc_test_same_float(a->theta_degC, b->theta_degC) &&
+           wc_test_same_float(a->pressure_model_Pa, b->pressure_model_Pa) &&
+           wc_test_same_float(a->held.slip_rad_s, b->held.slip_rad_s) &&
+           wc_test_same_float(a->held.theta_oil_degC, b->held.theta_oil_degC) &&
+           wc_test_same_float(a->held.theta_housing_degC, b->held.theta_housing_degC) &&
+           wc_test_same_float(a->held.torque_request_Nm, b->held.torque_request_Nm);
+}
+
+typedef enum { IN_SLIP, IN_OIL, IN_HOUSING, IN_TORQUE, IN_COUNT } input_t;
+
+static float *input_field(wc_step_input_t *in, input_t which)
+{
+    switch (which) {
+    case IN_SLIP: return &in->slip_rad_s;
+    case IN_OIL: return &in->theta_oil_degC;
+    case IN_HOUSING: return &in->theta_housing_degC;
+    default: return &in->torque_request_Nm;
+    }
+}
+
+static wc_status_t input_bit(input_t which)
+{
+    switch (which) {
+    case IN_SLIP: return WC_STATUS_SLIP_INVALID;
+    case IN_OIL:
+    case IN_HOUSING: return WC_STATUS_THETA_INVALID;
+    default: return WC_STATUS_TORQUE_INVALID;
+    }
+}
+
+/* One bad sample of one input at step bad_step: clutch A gets it, its twin B
+ * gets the last valid value of that input instead. Outputs (but the status
+ * bit) and state must stay bit-identical for the whole run. */
+static void run_twins(input_t which, float bad_value, int bad_step)
+{
+    wc_clutch_t a;
+    wc_clutch_t b;
+    assert_int_equal(wc_clutch_init(&a, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    assert_int_equal(wc_clutch_init(&b, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    wc_step_input_t last_valid = input(0.0f, 40.0f, 40.0f, 0.0f);  /* what init holds */
+    for (int k = 0; k < STEPS; ++k) {
+        wc_step_input_t in_a = profile(k);
+        wc_step_input_t in_b = in_a;
+        if (k == bad_step) {
+            *input_field(&in_a, which) = bad_value;
+            *input_field(&in_b, which) = *input_field(&last_valid, which);
+        } else {
+            last_valid = in_a;
+        }
+        wc_step_output_t out_a;
+        wc_step_output_t out_b;
+        const wc_status_t status_a = wc_clutch_step(&a, &in_a, &out_a);
+        const wc_status_t status_b = wc_clutch_step(&b, &in_b, &out_b);
+        WC_CHECK(status_a == out_a.status, "step %d: returned 0x%x, out 0x%x", k, (unsigned)status_a,
+                 (unsigned)out_a.status);
+        WC_CHECK(finite_output(&out_a), "input %d = %g at step %d: non-finite output at step %d", (int)which,
+                 (double)bad_value, bad_step, k);
+        WC_CHECK(same_output(&out_a, &out_b) && same_state(&a, &b),
+                 "input %d = %g at step %d: clutch differs from its twin at step %d (theta %.9g vs %.9g, "
+                 "current %.9g vs %.9g)",
+                 (int)which, (double)bad_value, bad_step, k, (double)a.theta_degC, (double)b.theta_degC,
+                 (double)out_a.current_mA, (double)out_b.current_mA);
+        const wc_status_t expected_a = (k == bad_step) ? (status_b | input_bit(which)) : status_b;
+        WC_CHECK(status_a == expected_a, "step %d: status 0x%x, expected 0x%x", k, (unsigned)status_a,
+                 (unsigned)expected_a);
+        WC_CHECK((status_b & WC_STATUS_INPUT_INVALID) == 0u, "step %d: twin status 0x%x", k, (unsigned)status_b);
+    }
+}
+
+static void test_one_bad_sample_does_not_corrupt_state(void **state)
+{
+    (void)state;
+    const float bad_any[] = { NAN, INFINITY, -INFINITY, -NAN };
+    const float out_of_range[IN_COUNT][3] = {
+        [IN_SLIP] = { nextafterf(WC_SLIP_MAX_rad_s, INFINITY), -2000.0f, FLT_MAX },
+        [IN_OIL] = { nextafterf(WC_THETA_MIN_degC, -INFINITY), nextafterf(WC_THETA_MAX_degC, INFINITY), -273.15f },
+        [IN_HOUSING] = { nextafterf(WC_THETA_MIN_degC, -INFINITY), 1000.0f, -FLT_MAX },
+        [IN_TORQUE] = { -FLT_MIN, -150.0f, nextafterf(WC_TORQUE_MAX_Nm, INFINITY) },
+    };
+    const int bad_steps[] = { 0, 350, 901 };  /* first step (init's held values), slipping, after a request step */
+    for (int which = 0; which < (int)IN_COUNT; ++which) {
+        for (size_t s = 0u; s < WC_TEST_COUNT(bad_steps); ++s) {
+            for (size_t v = 0u; v < WC_TEST_COUNT(bad_any); ++v) {
+                run_twins((input_t)which, bad_any[v], bad_steps[s]);
+            }
+            for (size_t v = 0u; v < 3u; ++v) {
+                run_twins((input_t)which, out_of_range[which][v], bad_steps[s]);
+            }
+        }
+    }
+}
+
+/* Everything invalid, for a long time: outputs stay finite and physical,
+ * the state holds (theta keeps following the held inputs). */
+static void test_all_inputs_bad_outputs_finite(void **state)
+{
+    (void)state;
+    const float bad[] = { NAN, INFINITY, -INFINITY, -1e30f };
+    wc_clutch_t c;
+    assert_int_equal(wc_clutch_init(&c, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    for (int k = 0; k < 500; ++k) {  /* some valid history first */
+        const wc_step_input_t in = profile(k);
+        wc_step_output_t out;
+        (void)wc_clutch_step(&c, &in, &out);
+    }
+    for (int k = 0; k < 4000; ++k) {
+        const float x = bad[(size_t)k % WC_TEST_COUNT(bad)];
+        const wc_step_input_t in = input(x, x, x, x);
+        wc_step_output_t out;
+        const wc_status_t status = wc_clutch_step(&c, &in, &out);
+        WC_CHECK((status & (WC_STATUS_SLIP_INVALID | WC_STATUS_THETA_INVALID | WC_STATUS_TORQUE_INVALID)) ==
+                     (WC_STATUS_SLIP_INVALID | WC_STATUS_THETA_INVALID | WC_STATUS_TORQUE_INVALID),
+                 "step %d: 0x%x", k, (unsigned)status);
+        WC_CHECK(finite_output(&out), "step %d", k);
+        WC_CHECK((out.current_mA >= wc_table1_calibration.vfs_current_min_mA) &&
+                     (out.current_mA <= wc_table1_calibration.vfs_current_max_mA),
+                 "current %g", (double)out.current_mA);
+        WC_CHECK(isfinite(c.theta_degC) && isfinite(c.pressure_model_Pa), "state at step %d", k);
+    }
+}
+
+/* Closed loop at zero slip with oil = housing = start temperature (no heat,
+ * no drift): after 1 s = 16.7 tau the modelled torque is the request.
+ * Tolerance: the bisection's 0.005 N times dT/dF (0.07 Nm/N at 40 degC),
+ * the lag's residual e^-16.7 = 6e-8 of the step, float rounding of T
+ * (1.5e-5 Nm): 0.01 Nm. */
+static void test_closed_loop_reaches_request(void **state)
+{
+    (void)state;
+    wc_clutch_t c;
+    assert_int_equal(wc_clutch_init(&c, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    const wc_step_input_t in = input(0.0f, 40.0f, 40.0f, 150.0f);
+    wc_step_output_t out;
+    for (int k = 0; k < 1000; ++k) {
+        assert_int_equal(wc_clutch_step(&c, &in, &out), WC_STATUS_OK);
+    }
+    WC_CHECK_CLOSE("model torque", 0, out.model.torque_Nm, 150.0, 0.0, 0.01);
+    WC_CHECK_CLOSE("pressure command", 0, out.pressure_command_Pa,
+                   (double)wc_table1_calibration.vfs_gain_Pa_per_mA * (double)out.current_mA, WC_TEST_FLT_EPSILON, 0.0);
+    WC_CHECK_CLOSE("theta", 0, out.theta_degC, 40.0, 0.0, 1e-4);
+}
+
+/* Two clutches with different calibrations side by side: interleaved steps
+ * give, bit for bit, what each gives alone. */
+static void run(wc_clutch_t *c, const wc_step_input_t *in, wc_step_output_t *out, int steps)
+{
+    for (int k = 0; k < steps; ++k) {
+        (void)wc_clutch_step(c, &in[k], &out[k]);
+    }
+}
+
+static void test_two_instances_do_not_interfere(void **state)
+{
+    (void)state;
+    wc_calibration_t other = wc_table1_calibration;  /* same film table, other friction and cooling */
+    other.mu1 = 1.25f * wc_table1_calibration.mu1;
+    other.oil_conductance_W_per_K = 0.6f * wc_table1_calibration.oil_conductance_W_per_K;
+    other.vfs_time_constant_s = 0.04f;
+
+    static wc_step_input_t in_a[STEPS];
+    static wc_step_input_t in_b[STEPS];
+    for (int k = 0; k < STEPS; ++k) {
+        in_a[k] = profile(k);
+        in_b[k] = profile(STEPS - 1 - k);  /* a different drive cycle too */
+        in_b[k].torque_request_Nm = 0.5f * in_b[k].torque_request_Nm + 20.0f;
+    }
+    static wc_step_output_t alone_a[STEPS];
+    static wc_step_output_t alone_b[STEPS];
+    wc_clutch_t a;
+    wc_clutch_t b;
+    assert_int_equal(wc_clutch_init(&a, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    run(&a, in_a, alone_a, STEPS);
+    assert_int_equal(wc_clutch_init(&b, &other, 55.0f), WC_CAL_OK);
+    run(&b, in_b, alone_b, STEPS);
+    const wc_clutch_t end_a = a;
+    const wc_clutch_t end_b = b;
+
+    /* Side by side, interleaved one step each, then in bursts. */
+    assert_int_equal(wc_clutch_init(&a, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    assert_int_equal(wc_clutch_init(&b, &other, 55.0f), WC_CAL_OK);
+    int ka = 0;
+    int kb = 0;
+    for (int round = 0; (ka < STEPS) || (kb < STEPS); ++round) {
+        const int burst_a = 1 + (round % 3);
+        const int burst_b = 1 + (round % 5);
+        for (int j = 0; (j < burst_a) && (ka < STEPS); ++j, ++ka) {
+            wc_step_output_t out;
+            (void)wc_clutch_step(&a, &in_a[ka], &out);
+            WC_CHECK(same_output(&out, &alone_a[ka]) && (out.status == alone_a[ka].status), "A differs at step %d", ka);
+        }
+        for (int j = 0; (j < burst_b) && (kb < STEPS); ++j, ++kb) {
+            wc_step_output_t out;
+            (void)wc_clutch_step(&b, &in_b[kb], &out);
+            WC_CHECK(same_output(&out, &alone_b[kb]) && (out.status == alone_b[kb].status), "B differs at step %d", kb);
+        }
+    }
+    WC_CHECK(same_state(&a, &end_a) && (a.model.cal == &wc_table1_calibration), "A's end state");
+    WC_CHECK(same_state(&b, &end_b) && (b.model.cal == &other), "B's end state");
+
+    /* ...and the two really are different clutches: same inputs, other outputs. */
+    wc_clutch_t c1;
+    wc_clutch_t c2;
+    assert_int_equal(wc_clutch_init(&c1, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    assert_int_equal(wc_clutch_init(&c2, &other, 40.0f), WC_CAL_OK);
+    static wc_step_output_t out1[STEPS];
+    static wc_step_output_t out2[STEPS];
+    run(&c1, in_a, out1, STEPS);
+    run(&c2, in_a, out2, STEPS);
+    WC_CHECK(fabsf(out1[600].current_mA - out2[600].current_mA) > 1.0f, "currents %g %g", (double)out1[600].current_mA,
+             (double)out2[600].current_mA);
+    WC_CHECK(fabsf(c1.theta_degC - c2.theta_degC) > 0.1f, "theta %g %g", (double)c1.theta_degC, (double)c2.theta_degC);
+}
+
+static void test_init_start_temperature(void **state)
+{
+    (void)state;
+    wc_clutch_t c;
+    assert_int_equal(wc_clutch_init(&c, &wc_table1_calibration, 72.5f), WC_CAL_OK);
+    WC_CHECK(wc_test_same_float(c.theta_degC, 72.5f), "theta %g", (double)c.theta_degC);
+    /* The VFS starts at rest: the pressure of the minimum current. */
+    WC_CHECK(wc_test_same_float(c.pressure_model_Pa, wc_table1_calibration.vfs_gain_Pa_per_mA *
+                                                         wc_table1_calibration.vfs_current_min_mA),
+             "pressure %g", (double)c.pressure_model_Pa);
+    /* out->theta_degC is the estimate before this step's update. */
+    const wc_step_input_t in = input(100.0f, 40.0f, 40.0f, 150.0f);
+    wc_step_output_t out;
+    assert_int_equal(wc_clutch_step(&c, &in, &out), WC_STATUS_OK);
+    WC_CHECK(wc_test_same_float(out.theta_degC, 72.5f), "theta %g", (double)out.theta_degC);
+    WC_CHECK(!wc_test_same_float(c.theta_degC, 72.5f), "observer did not move");
+}
+
+/* The inverse and the torque model run at the observer's estimate, not at the
+ * oil temperature: start the observer at 90 degC with 40 degC oil; the first
+ * step's command is the golden inverse of 150 Nm at 750 rpm, 90 degC, and
+ * its mu_f the golden one at 750 rpm, 90 degC (tolerances: test_inverse.c,
+ * test_friction.c). */
+static const wc_golden_inverse_t *golden_inverse_row(double slip_rpm, double theta_degC, double torque_Nm)
+{
+    for (size_t i = 0u; i < WC_TEST_COUNT(wc_golden_inverse); ++i) {
+        const wc_golden_inverse_t *g = &wc_golden_inverse[i];
+        if ((fabs(g->slip_rpm - slip_rpm) < 1e-9) && (fabs(g->theta_degC - theta_degC) < 1e-9) &&
+            (fabs(g->torque_Nm - torque_Nm) < 1e-9)) {
+            return g;
+        }
+    }
+    return NULL;
+}
+
+static void test_step_uses_the_temperature_estimate(void **state)
+{
+    (void)state;
+    const wc_golden_inverse_t *g = golden_inverse_row(750.0, 90.0, 150.0);
+    assert_non_null(g);
+    wc_clutch_t c;
+    assert_int_equal(wc_clutch_init(&c, &wc_table1_calibration, 90.0f), WC_CAL_OK);
+    const wc_step_input_t in = input(wc_test_rpm_to_rad_s(750.0), 40.0f, 40.0f, 150.0f);
+    wc_step_output_t out;
+    assert_int_equal(wc_clutch_step(&c, &in, &out), (wc_status_t)g->status);
+    WC_CHECK_CLOSE("force command", 0, out.force_command_N, g->force_N, 1e-4, 0.01);
+    WC_CHECK_CLOSE("current", 0, out.current_mA, g->current_mA, 1e-4, 0.0);
+    double mu_f = NAN;
+    for (size_t i = 0u; i < WC_TEST_COUNT(wc_golden_torque); ++i) {
+        if ((fabs(wc_golden_torque[i].slip_rpm - 750.0) < 1e-9) && (fabs(wc_golden_torque[i].theta_degC - 90.0) < 1e-9)) {
+            mu_f = wc_golden_torque[i].mu_f;
+        }
+    }
+    WC_CHECK_CLOSE("mu_f at 90 degC", 0, out.model.mu_f, mu_f, 2e-6, 0.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_start_temperature),
+        cmocka_unit_test(test_step_uses_the_temperature_estimate),
+        cmocka_unit_test(test_one_bad_sample_does_not_corrupt_state),
+        cmocka_unit_test(test_all_inputs_bad_outputs_finite),
+        cmocka_unit_test(test_closed_loop_reaches_request),
+        cmocka_unit_test(test_two_instances_do_not_interfere),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
