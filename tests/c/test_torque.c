@@ -23,7 +23,7 @@ static int setup(void **state)
  *  - coulomb = R_eff N_c mu_f F: no LUT; mu_f in float (<= 2e-6, test_friction.c)
  *    and three more float roundings;
  *  - mu_f: see test_friction.c.
- * The required bar is 1e-4 relative for all; these are tighter and still justified. *
+ * The required bar is 1e-4 relative for all; these are tighter and still justified. */
 #define HBAR_REL_TOL 5e-5
 #define VISCOUS_REL_TOL 5e-5
 #define TORQUE_REL_TOL 5e-5
