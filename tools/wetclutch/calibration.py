@@ -169,5 +169,9 @@ def _check_relations(cal: Calibration) -> None:
         raise CalibrationError(f"{p}: parameter 'geometry.inner_radius' must be < geometry.outer_radius")
     if cal.vfs_current_max <= cal.vfs_current_min:
         raise CalibrationError(f"{p}: parameter 'hydraulics.vfs_current_max' must be > hydraulics.vfs_current_min")
+    force_max = cal.vfs_gain * cal.vfs_current_max * cal.piston_area - cal.return_spring_force
+    if force_max / cal.friction_area > cal.contact_pressure_max:
+        raise CalibrationError(f"{p}: parameter 'film_lut.contact_pressure_max' must cover the contact pressure at"
+                               f" the maximum current ({force_max / cal.friction_area:.6g} Pa)")
     if cal.nodes < 2:
         raise CalibrationError(f"{p}: parameter 'film_lut.nodes' must be >= 2")

@@ -69,7 +69,7 @@ def separation_from_pressure_m(cal: Calibration, pressure_Pa):
     s = cal.roughness_rms
     lo = np.full(p.shape, -60.0 * s)
     hi = np.full(p.shape, 60.0 * s)
-    for _ in range(200):  # interval shrinks to below 1e-50 m: exact in double
+    for _ in range(64):  # 120 sigma / 2^64 < 1e-22 m: exact in double
         mid = 0.5 * (lo + hi)
         above = contact_pressure_Pa(cal, mid) > p
         lo = np.where(above, mid, lo)
@@ -133,27 +133,44 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
     """Torque request (magnitude, Nm) -> contact force -> piston pressure -> VFS current.
 
     Returns a dict: force_N, pressure_Pa, current_mA, status (bits above).
-    The force solves |T(F)| = request exactly (vectorized bisection in double).
+    Solves |T(F)| = request exactly. Where the film is clamped (p_c below the
+    table's first node) T is linear in F and is solved directly; elsewhere the
+    unknown is the nominal separation h, with F = A_f p_c(h) and h_bar(h) in
+    closed form (eq. 9, 15), by vectorized bisection in double precision.
     """
     slip = np.abs(np.asarray(slip_rpm, dtype=float))
     theta = np.asarray(theta_degC, dtype=float)
     req = np.asarray(torque_Nm, dtype=float)
     slip, theta, req = np.broadcast_arrays(slip, theta, req)
     f_max = force_max_N(cal)
+    _, h_max, p_min, _ = film_domain(cal)
 
-    def mag(force):
-        return np.abs(torque_parts(cal, slip, theta, force)["torque_Nm"])
+    speed = cal.effective_radius * slip * RAD_S_PER_RPM
+    arm = cal.effective_radius * cal.friction_pairs
+    coulomb_per_N = arm * friction_coefficient(cal, speed, theta)              # eq. 6, 18
+    viscous_m = arm * viscosity_Pa_s(cal, theta) * cal.friction_area * speed   # eq. 7 times h_bar
 
-    drag = mag(np.zeros(req.shape))
-    cap = mag(np.full(req.shape, f_max))
-    lo = np.zeros(req.shape)
-    hi = np.full(req.shape, f_max)
-    for _ in range(80):  # f_max / 2^80: exact in double
+    def torque_at(force):
+        return coulomb_per_N * force + viscous_m / hbar_from_pressure_m(cal, force / cal.friction_area)
+
+    drag = torque_at(np.zeros(req.shape))
+    cap = torque_at(np.full(req.shape, f_max))
+    # Clamped-film region, 0 <= F <= A_f p_min: T = c F + V / h_bar(h_max).
+    f_knee = min(cal.friction_area * p_min, f_max)
+    hbar_open = float(film_thickness_m(cal, h_max))
+    force_linear = (req - viscous_m / hbar_open) / coulomb_per_N
+    # Beyond it: bisection on h, T(h) strictly decreasing in h.
+    lo = np.full(req.shape, float(separation_from_pressure_m(cal, np.array([f_max / cal.friction_area]))[0]))
+    hi = np.full(req.shape, h_max)
+    for _ in range(100):  # 40 um / 2^100: exact in double
         mid = 0.5 * (lo + hi)
-        low = mag(mid) < req
-        lo = np.where(low, mid, lo)
-        hi = np.where(low, hi, mid)
-    force = 0.5 * (lo + hi)
+        t_mid = coulomb_per_N * cal.friction_area * contact_pressure_Pa(cal, mid) + viscous_m / film_thickness_m(cal, mid)
+        high = t_mid > req
+        lo = np.where(high, mid, lo)
+        hi = np.where(high, hi, mid)
+    force_curve = cal.friction_area * contact_pressure_Pa(cal, 0.5 * (lo + hi))
+    force = np.where(req <= torque_at(np.full(req.shape, f_knee)), force_linear, force_curve)
+
     status = np.zeros(req.shape, dtype=int)
     below = req <= drag
     above = req > cap
@@ -197,4 +214,55 @@ def thermal_observer(cal: Calibration, slip_rpm, torque_Nm, theta_oil_degC, thet
     for k in range(slip.size):
         out[k] = theta
         theta = steady[k] + (theta - steady[k]) * a
+    return out
+
+
+MODE_TORQUE, MODE_OPEN, MODE_LOCKED = 0, 1, 2
+
+
+def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
+                 mode=None, theta_start_degC=None):
+    """The firmware's wc_clutch_step, composed in double precision, one row per period.
+
+    Per step k: inverse at theta[k] (or the solenoid's minimum/maximum current
+    for the open/locked modes) -> current; VFS lag (exact, tau) -> reached
+    pressure -> contact force F = max(P A_p - F_s, 0) -> model torque;
+    observer advanced with |T dw|. Returns a dict of arrays; theta_degC[k] is
+    the estimate used in step k (before its update).
+    """
+    slip = np.asarray(slip_rpm, dtype=float)
+    n = slip.size
+    oil = np.broadcast_to(np.asarray(theta_oil_degC, dtype=float), (n,))
+    housing = np.broadcast_to(np.asarray(theta_housing_degC, dtype=float), (n,))
+    request = np.broadcast_to(np.asarray(torque_request_Nm, dtype=float), (n,))
+    modes = np.broadcast_to(np.asarray(MODE_TORQUE if mode is None else mode), (n,))
+    a_th = thermal_decay(cal, cal.period)
+    a_vfs = math.exp(-cal.period / cal.vfs_time_constant)
+    theta = float(oil[0]) if theta_start_degC is None else float(theta_start_degC)
+    pressure = cal.vfs_gain * cal.vfs_current_min
+    names = ("current_mA", "pressure_command_Pa", "pressure_model_Pa", "force_command_N", "theta_degC",
+             "torque_Nm", "mu_f", "hbar_m", "status")
+    out = {k: np.empty(n) for k in names}
+    for k in range(n):
+        out["theta_degC"][k] = theta
+        if modes[k] == MODE_TORQUE:
+            inv = inverse(cal, slip[k], theta, request[k])
+            current, force_cmd, status = float(inv["current_mA"]), float(inv["force_N"]), int(inv["status"])
+        else:
+            current = cal.vfs_current_max if modes[k] == MODE_LOCKED else cal.vfs_current_min
+            force_cmd = max(cal.vfs_gain * current * cal.piston_area - cal.return_spring_force, 0.0)
+            status = 0
+        target = cal.vfs_gain * current
+        pressure = target + (pressure - target) * a_vfs
+        force = max(pressure * cal.piston_area - cal.return_spring_force, 0.0)
+        parts = torque_parts(cal, slip[k], theta, force)
+        torque = float(parts["torque_Nm"])
+        power = abs(torque * slip[k] * RAD_S_PER_RPM)
+        steady = float(thermal_steady_degC(cal, power, oil[k], housing[k]))
+        theta = steady + (theta - steady) * a_th
+        for key, value in (("current_mA", current), ("pressure_command_Pa", target), ("pressure_model_Pa", pressure),
+                           ("force_command_N", force_cmd), ("torque_Nm", torque), ("mu_f", float(parts["mu_f"])),
+                           ("hbar_m", float(parts["hbar_m"])), ("status", status)):
+            out[key][k] = value
+    out["status"] = out["status"].astype(int)
     return out
