@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Replay a candump -L log to the TCU program on a live SocketCAN interface and
+# capture the bus. Runs where the interface exists (natively or inside the VM
+# started by hil/vcan_run.sh):
+#   bash hil/replay_guest.sh LOG OUTDIR [--iface vcan0] [--log-iface NAME]
+#                            [--frame-runs N] [--timer-runs N] [--tcu PATH]
+# Each run: candump -L captures the bus, wc_tcu runs (frame clock: one step per
+# ClutchSensors frame; timer clock: fixed period), canplayer plays LOG with its
+# timing, wc_tcu stops when the bus has been idle for 1 s. Output per run:
+# OUTDIR/<clock><n>.log (capture), .json (wc_tcu statistics), .txt (wc_tcu stderr).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+die() { echo "replay_guest: $*" >&2; exit 2; }
+[ $# -ge 2 ] || die "usage: $0 LOG OUTDIR [--iface vcan0] [--log-iface NAME] [--frame-runs N] [--timer-runs N] [--tcu PATH]"
+log=$1 out=$2; shift 2
+iface=vcan0 log_iface="" frame_runs=2 timer_runs=1 tcu="$repo/build/host-release/src/port/wc_tcu"
+while [ $# -gt 0 ]; do
+  case $1 in
+    --iface) iface=$2; shift 2 ;;
+    --log-iface) log_iface=$2; shift 2 ;;
+    --frame-runs) frame_runs=$2; shift 2 ;;
+    --timer-runs) timer_runs=$2; shift 2 ;;
+    --tcu) tcu=$2; shift 2 ;;
+    *) die "unknown option '$1'" ;;
+  esac
+done
+[ -r "$log" ] || die "cannot read log $log"
+[ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
+for tool in candump canplayer; do command -v $tool >/dev/null || die "$tool not found (Debian package can-utils; bash scripts/setup.sh)"; done
+[ -n "$log_iface" ] || log_iface=$(awk 'NF>=3 {print $2; exit}' "$log")
+mkdir -p "$out"
+
+one_run() { # clock name
+  local clock=$1 name=$2 dump_pid tcu_pid rc=0
+  candump -L "$iface" >"$out/$name.log" &
+  dump_pid=$!
+  "$tcu" --iface "$iface" --clock "$clock" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
+  tcu_pid=$!
+  for _ in $(seq 100); do grep -q "clock $clock" "$out/$name.txt" 2>/dev/null && break; sleep 0.05; done
+  grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill $dump_pid $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }
+  sleep 0.2  # candump's socket is bound by now too
+  canplayer -I "$log" "$iface=$log_iface"
+  wait $tcu_pid || rc=$?
+  sleep 0.2
+  kill $dump_pid 2>/dev/null || true
+  wait $dump_pid 2>/dev/null || true
+  [ "$rc" = 0 ] || { cat "$out/$name.txt" >&2; die "wc_tcu exited with $rc ($name)"; }
+  echo "replay_guest: $name: $(grep -c . "$out/$name.log") frames captured" >&2
+}
+for i in $(seq "$frame_runs"); do one_run frame "frame$i"; done
+for i in $(seq "$timer_runs"); do one_run timer "timer$i"; done

@@ -1,0 +1,140 @@
+"""CAN logs in candump -L format, encoded and decoded with the DBC (hil/wetclutch.dbc).
+
+Encoding and decoding use cantools (the DBC is the single source of truth);
+log files are read and written with python-can's candump-log classes. The
+E2E CRC (SAE J1850 over the data id then bytes 1..7) and the alive counter
+are computed here independently of the firmware's C code, so a mismatch
+between the two shows up as rejected frames.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import can
+import cantools
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+DBC_PATH = ROOT / "hil" / "wetclutch.dbc"
+
+SENSORS, REQUEST, COMMAND, ESTIMATE, BENCH = (
+    "ClutchSensors", "TorqueRequest", "VfsCommand", "ClutchEstimate", "BenchMeasurement")
+E2E_FRAMES = (SENSORS, REQUEST, COMMAND)
+MODE_OPEN, MODE_TORQUE_CONTROL, MODE_LOCKED = 0, 1, 2
+
+
+class LogError(Exception):
+    """A log that cannot be used; the message says where."""
+
+
+def database(path: Path = DBC_PATH) -> cantools.database.Database:
+    return cantools.database.load_file(str(path), strict=True)
+
+
+def crc8_j1850(data: bytes) -> int:
+    crc = 0xFF
+    for byte in data:
+        crc ^= byte
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc ^ 0xFF
+
+
+def protect(frame_id: int, payload: bytearray) -> bytearray:
+    payload[0] = crc8_j1850(bytes([frame_id & 0xFF]) + bytes(payload[1:8]))
+    return payload
+
+
+@dataclass
+class Encoder:
+    """Encodes physical values to frames, keeping one alive counter per E2E frame."""
+
+    db: cantools.database.Database = field(default_factory=database)
+    counters: dict = field(default_factory=dict)
+
+    def frame(self, name: str, **signals) -> can.Message:
+        msg = self.db.get_message_by_name(name)
+        if name in E2E_FRAMES:
+            count = self.counters.get(name, 0)
+            self.counters[name] = (count + 1) % 16
+            signals = {"Crc": 0, "AliveCounter": count, **signals}
+        data = bytearray(msg.encode(signals, scaling=True, strict=True))
+        if name in E2E_FRAMES:
+            protect(msg.frame_id, data)
+        return can.Message(arbitration_id=msg.frame_id, is_extended_id=False, data=bytes(data))
+
+
+def write_log(path: Path, messages: list[tuple[float, can.Message]], channel: str = "vcan0") -> None:
+    """Write (timestamp_s, message) pairs as a candump -L log.
+
+    Written by hand rather than with python-can's writer, which appends a
+    direction field (' R') that can-utils 2020.11 canplayer does not expect."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="\n") as f:
+        for stamp, msg in messages:
+            ident = f"{msg.arbitration_id:08X}" if msg.is_extended_id else f"{msg.arbitration_id:03X}"
+            f.write(f"({stamp:.6f}) {channel} {ident}#{bytes(msg.data).hex().upper()}\n")
+
+
+def input_log(t_s, slip_rpm, oil_degC, housing_degC, request_Nm, mode=MODE_TORQUE_CONTROL,
+              bench=None, start_s: float = 1.0e6):
+    """Frames the TCU receives, one period per row: TorqueRequest then ClutchSensors
+    (so each step sees that period's request), then BenchMeasurement if given
+    (dict of arrays load_cell_N, torque_Nm, thermistor_degC)."""
+    enc = Encoder()
+    n = len(t_s)
+    modes = np.broadcast_to(np.asarray(mode), (n,))
+    out = []
+    for k in range(n):
+        stamp = start_s + float(t_s[k])
+        out.append((stamp, enc.frame(REQUEST, TorqueRequest=float(request_Nm[k]), Mode=int(modes[k]))))
+        out.append((stamp + 2e-6, enc.frame(SENSORS, SlipSpeed=float(slip_rpm[k]), OilTemp=float(oil_degC[k]),
+                                            HousingTemp=float(housing_degC[k]))))
+        if bench is not None:
+            out.append((stamp + 4e-6, enc.frame(BENCH, LoadCellForce=float(bench["load_cell_N"][k]),
+                                                MeasuredTorque=float(bench["torque_Nm"][k]),
+                                                ClutchThermistorTemp=float(bench["thermistor_degC"][k]))))
+    return out
+
+
+def read_log(path: Path) -> list[can.Message]:
+    """Read a candump -L log; a malformed line is an error naming the line."""
+    path = Path(path)
+    if not path.is_file():
+        raise LogError(f"{path}: no such log file")
+    messages = []
+    with open(path) as f:
+        for line_no, line in enumerate(f, start=1):
+            if not line.strip():
+                continue
+            try:
+                msg = next(iter(can.CanutilsLogReader([line])))
+            except (StopIteration, ValueError, IndexError) as e:
+                raise LogError(f"{path}: line {line_no}: not a candump -L line: {line.strip()!r} ({e})") from None
+            messages.append(msg)
+    return messages
+
+
+def decode(messages, db=None) -> dict[str, dict[str, np.ndarray]]:
+    """Decode every known frame into arrays of physical values per frame name,
+    plus '_t' (timestamps). Unknown ids are counted under '_unknown'."""
+    db = db or database()
+    rows: dict[str, list] = {}
+    unknown = 0
+    for msg in messages:
+        try:
+            spec = db.get_message_by_frame_id(msg.arbitration_id)
+        except KeyError:
+            unknown += 1
+            continue
+        values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
+        rows.setdefault(spec.name, []).append((msg.timestamp, values))
+    out = {}
+    for name, items in rows.items():
+        cols = {"_t": np.array([t for t, _ in items])}
+        for key in items[0][1]:
+            cols[key] = np.array([float(v[key]) for _, v in items])
+        out[name] = cols
+    out["_unknown"] = {"count": unknown}
+    return out
