@@ -32,7 +32,7 @@ mkdir -p "$out"
 
 one_run() { # clock name
   local clock=$1 name=$2 dump_pid tcu_pid rc=0
-  candump -L "$iface" >"$out/$name.log" &
+  candump -L -r 8388608 "$iface" >"$out/$name.log" &
   dump_pid=$!
   "$tcu" --iface "$iface" --clock "$clock" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
   tcu_pid=$!

@@ -27,6 +27,7 @@ preset=cortex-m4f
 build="$repo/build/$preset"
 work="$build/check_arm"
 lib="$build/libwetclutch.a"
+can_lib="$build/libwetclutch_can.a"
 prefix=arm-none-eabi-
 
 for tool in cmake ninja python3 ${prefix}gcc ${prefix}nm ${prefix}size ${prefix}objdump; do
@@ -65,21 +66,35 @@ extern const unsigned char wc_probe_inverse_max_iterations[WC_INVERSE_MAX_ITERAT
 const unsigned char wc_probe_inverse_max_iterations[WC_INVERSE_MAX_ITERATIONS] = {0u};
 EOF
 cat >"$work/wc_arm_main.c" <<'EOF'
-/* Smallest firmware that uses the library: init one clutch from table1, step it. */
+/* Smallest firmware that uses the library: init one clutch from table1, step it,
+ * and run the CAN frame loop once. */
 #include "wetclutch.h"
+#include "wc_loop.h"
 #include "wc_table1_calibration.h"
 
 volatile float wc_probe_in[4];
 volatile float wc_probe_out;
+volatile uint8_t wc_probe_frame[8];
 static wc_clutch_t clutch;
+static wc_loop_t loop;
 
 int main(void)
 {
     if (wc_clutch_init(&clutch, &wc_table1_calibration, wc_probe_in[1]) != WC_CAL_OK) { return 1; }
-    const wc_step_input_t in = { wc_probe_in[0], wc_probe_in[1], wc_probe_in[2], wc_probe_in[3] };
+    const wc_step_input_t in = { wc_probe_in[0], wc_probe_in[1], wc_probe_in[2], wc_probe_in[3], WC_MODE_TORQUE };
     wc_step_output_t out;
     (void)wc_clutch_step(&clutch, &in, &out);
     wc_probe_out = out.current_mA;
+
+    /* The CAN frame loop too: one received frame, one step, two frames out. */
+    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    if (wc_loop_init(&loop, &wc_table1_calibration, &config, wc_probe_in[1]) != WC_CAL_OK) { return 1; }
+    wc_can_frame_t rx = { WC_CAN_CLUTCH_SENSORS_FRAME_ID, 8u, 0u, {0u} };
+    for (unsigned i = 0u; i < 8u; ++i) { rx.data[i] = wc_probe_frame[i]; }
+    (void)wc_loop_receive(&loop, &rx);
+    wc_can_frame_t tx[WC_LOOP_TX_FRAMES];
+    (void)wc_loop_step(&loop, tx);
+    wc_probe_frame[0] = tx[0].data[2];
     return (int)out.status;
 }
 EOF
@@ -114,6 +129,7 @@ else:
     sys.exit("compile_commands.json has no src/wc_clutch.c")
 EOF
 )
+cflags+=("-I$repo/src/can")  # the CAN layer's headers, for the loop in the probe firmware
 cpu_flags=(-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16)
 for tu in wc_arm_calibration wc_arm_probe wc_arm_main wc_arm_baseline; do
   if ! (cd "$work" && ${prefix}gcc "${cflags[@]}" -c "$tu.c" -o "$tu.o") >"$log" 2>&1; then
@@ -121,7 +137,7 @@ for tu in wc_arm_calibration wc_arm_probe wc_arm_main wc_arm_baseline; do
   fi
 done
 ldflags=("${cpu_flags[@]}" -Os --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections)
-if ! { ${prefix}gcc "${ldflags[@]}" -o "$work/firmware.elf" "$work/wc_arm_main.o" "$lib" -lm \
+if ! { ${prefix}gcc "${ldflags[@]}" -o "$work/firmware.elf" "$work/wc_arm_main.o" "$can_lib" "$lib" -lm \
          -Wl,-Map="$work/firmware.map" &&
        ${prefix}gcc "${ldflags[@]}" -o "$work/baseline.elf" "$work/wc_arm_baseline.o"; } >"$log" 2>&1; then
   cat "$log" >&2; echo "check_arm: FAIL: linking the probe firmware" >&2; exit 1
@@ -137,7 +153,7 @@ forbidden_re+='|__aeabi_d[a-z0-9_]*|__aeabi_[a-z0-9]+2d|__[a-z]+df[0-9]?|__[a-z]
 
 status=0
 # Undefined references of every ARM object of the library and of the probes.
-undefined=$( { ${prefix}nm -u "$lib"; ${prefix}nm -u "$work"/wc_arm_calibration.o "$work"/wc_arm_probe.o; } \
+undefined=$( { ${prefix}nm -u "$lib" "$can_lib"; ${prefix}nm -u "$work"/wc_arm_calibration.o "$work"/wc_arm_probe.o; } \
              | awk 'NF == 2 && $1 == "U" { print $2 }' | sort -u)
 bad_objects=$(grep -E "$forbidden_re" <<<"$undefined" || true)
 # Functions the library brings into a linked image (not in the baseline image).
@@ -147,7 +163,7 @@ bad_image=$(grep -E "$forbidden_re" <<<"$brought_in" || true)
 if [ -n "$bad_objects" ]; then
   echo "check_arm: FAIL: ARM objects reference forbidden symbols:" >&2
   for s in $bad_objects; do
-    echo "  $s  <- $( { ${prefix}nm -A -u "$lib"; ${prefix}nm -A -u "$work"/wc_arm_calibration.o; } \
+    echo "  $s  <- $( { ${prefix}nm -A -u "$lib" "$can_lib"; ${prefix}nm -A -u "$work"/wc_arm_calibration.o; } \
                        | awk -v s="$s" '$NF == s { sub(/:$/, "", $1); n = split($1, p, /[:\/]/); print p[n] }' \
                        | sort -u | tr '\n' ' ')" >&2
   done
@@ -157,12 +173,13 @@ if [ -n "$bad_image" ]; then
   echo "check_arm: FAIL: the linked image pulls in forbidden functions:" $bad_image >&2
   status=1
 fi
-external=$(comm -23 <(echo "$undefined") <( { ${prefix}nm --defined-only "$lib" "$work"/*.o; } \
+external=$(comm -23 <(echo "$undefined") <( { ${prefix}nm --defined-only "$lib" "$can_lib" "$work"/*.o; } \
            | awk 'NF == 3 { print $3 }' | sort -u) | tr '\n' ' ')
 
 # --- figures ------------------------------------------------------------------
 sizes() { ${prefix}size -t "$@" | awk 'END { print $1, $2, $3 }'; }
 read -r lib_text lib_data lib_bss < <(sizes "$lib")
+read -r can_text can_data can_bss < <(sizes "$can_lib")
 read -r cal_text cal_data cal_bss < <(sizes "$work/wc_arm_calibration.o")
 read -r fw_text fw_data fw_bss < <(sizes "$work/firmware.elf")
 read -r base_text base_data base_bss < <(sizes "$work/baseline.elf")
@@ -192,12 +209,12 @@ read -r force_max needed < <(awk -v k="$(lut_value vfs_gain_Pa_per_mA)" -v i="$(
 
 # Stack: own frames (.su) summed along the call graph (.ci); functions outside
 # the library (expf and what it calls) from their prologues in the linked image.
-stack_report=$(python3 - "$build/CMakeFiles/wetclutch.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
+stack_report=$(python3 - "$build/CMakeFiles/wetclutch.dir:$build/CMakeFiles/wetclutch_can.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
 import glob, os, re, subprocess, sys
 objdir, elf, objdump, incdir = sys.argv[1:5]
 
 nodes, edges, names = {}, {}, {}
-for ci in glob.glob(os.path.join(objdir, "**", "*.ci"), recursive=True):
+for ci in [f for d in objdir.split(":") for f in glob.glob(os.path.join(d, "**", "*.ci"), recursive=True)]:
     text = open(ci).read()
     for m in re.finditer(r'node: \{ title: "([^"]+)" label: "([^"]*)"', text):
         title, label = m.groups()
@@ -300,11 +317,12 @@ arm-none-eabi-gcc $gcc_version, preset $preset: -mcpu=cortex-m4 -mthumb -mfloat-
 
 | figure | value | |
 |---|---|---|
-| library (libwetclutch.a) text/data/bss | $lib_text / $lib_data / $lib_bss B | all public functions |
+| model library (libwetclutch.a) text/data/bss | $lib_text / $lib_data / $lib_bss B | all public functions |
 | table1 calibration + film LUT text/data/bss | $cal_text / $cal_data / $cal_bss B | static const, in the user's TU |
 | flash, library + LUT | $flash_total B ($(awk -v b="$flash_total" 'BEGIN { printf "%.2f", b / 1024 }') KiB) | $(goal "$flash_total" 8192) |
 | static RAM, library + LUT | $ram_static B | state lives in the caller's wc_clutch_t |
-| flash of a linked init+step firmware, minus an empty one | $linked_flash B | gc-sections; includes newlib expf |
+| CAN layer (libwetclutch_can.a: codec, E2E, frame loop) text/data/bss | $can_text / $can_data / $can_bss B | optional; every frame's pack and unpack |
+| flash of a linked firmware (clutch init+step, loop init+step), minus an empty one | $linked_flash B | gc-sections; includes newlib expf, roundf |
 | state per clutch, sizeof(wc_clutch_t) | $state_bytes B (of which wc_model_t $model_bytes B) | $(goal "$state_bytes" 64) |
 | worst stack, public entry point | $worst_public B, $worst_public_name | $(goal "$worst_public" 256) |
 | stack of wc_clutch_step | $step_stack B | |
@@ -313,13 +331,13 @@ arm-none-eabi-gcc $gcc_version, preset $preset: -mcpu=cortex-m4 -mthumb -mfloat-
 
 Worst chain: $worst_public_path
 
-Stack per global function (own frame from -fstack-usage, total along the
+Stack per public function (own frame from -fstack-usage, total along the
 -fcallgraph-info call graph; ~ = includes newlib callees measured from their
 prologues in the linked image):
 
 | function | own B | total B | chain |
 |---|---:|---:|---|
-$(awk -F'\t' '{ printf "| %s%s | %d | %s%d | %s |\n", $2, ($1 == "public" ? "" : " (internal)"), $3, $5, $4, $6 }' <<<"$stack_report")
+$(awk -F'\t' '$1 == "public" { printf "| %s | %d | %s%d | %s |\n", $2, $3, $5, $4, $6 }' <<<"$stack_report")
 
 Undefined symbols the library needs from outside: ${external:-none}
 EOF

@@ -24,6 +24,7 @@ static int fail(wc_socketcan_t *port, const char *what, int err, const char *hin
 int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *filter_ids, size_t count)
 {
     port->fd = -1;
+    port->rx_dropped = 0;
     port->error[0] = '\0';
     if (strlen(iface) >= IFNAMSIZ) {
         return fail(port, "interface name too long", ENAMETOOLONG, "");
@@ -61,6 +62,18 @@ int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *f
         (void)close(fd);
         return fail(port, "setsockopt(CAN_RAW_FILTER)", err, "");
     }
+    /* Ask for the kernel's drop counter with every frame, so no loss goes unseen,
+     * and a receive buffer large enough for bursts of a replayed log. */
+    const int one = 1;
+    const int rcvbuf = 1 << 20;
+    if (setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one) < 0) {
+        const int err = errno;
+        (void)close(fd);
+        return fail(port, "setsockopt(SO_RXQ_OVFL)", err, "");
+    }
+    if (setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &rcvbuf, sizeof rcvbuf) < 0) {
+        (void)setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);  /* not root: best effort */
+    }
     struct sockaddr_can addr;
     memset(&addr, 0, sizeof addr);
     addr.can_family = AF_CAN;
@@ -85,10 +98,18 @@ int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t ti
     }
     if (ready == 0) { return 0; }
     struct can_frame raw;
-    const ssize_t n = read(port->fd, &raw, sizeof raw);
+    char control[CMSG_SPACE(sizeof(uint32_t))];
+    struct iovec iov = { .iov_base = &raw, .iov_len = sizeof raw };
+    struct msghdr msg = { .msg_iov = &iov, .msg_iovlen = 1, .msg_control = control, .msg_controllen = sizeof control };
+    const ssize_t n = recvmsg(port->fd, &msg, 0);
     if (n < 0) {
         if ((errno == EINTR) || (errno == EAGAIN)) { return 0; }
         return fail(port, "read", errno, "");
+    }
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c != NULL; c = CMSG_NXTHDR(&msg, c)) {
+        if ((c->cmsg_level == SOL_SOCKET) && (c->cmsg_type == SO_RXQ_OVFL)) {
+            memcpy(&port->rx_dropped, CMSG_DATA(c), sizeof port->rx_dropped);  /* cumulative */
+        }
     }
     memset(frame, 0, sizeof *frame);
     if ((size_t)n < sizeof raw) {  /* never from a CAN_RAW socket, but never trust a length */

@@ -11,7 +11,8 @@
 
 typedef struct {
     int fd;
-    char error[256];   /* last error, human readable */
+    uint32_t rx_dropped;  /* frames the kernel dropped before we read them (SO_RXQ_OVFL) */
+    char error[256];      /* last error, human readable */
 } wc_socketcan_t;
 
 /* Open and bind; filter_ids (count entries, standard 11-bit ids) become the

@@ -20,9 +20,9 @@
 #include "wc_socketcan.h"
 #include "wc_table1_calibration.h"
 
-/* Step-time histogram: 100 ns bins up to 1 ms, one overflow bin; the max is kept exactly. */
-#define HIST_BIN_NS 100
-#define HIST_BINS 10000
+/* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
+#define HIST_BIN_NS 1000
+#define HIST_BINS 50000
 
 typedef struct {
     uint64_t bins[HIST_BINS + 1];
@@ -150,12 +150,14 @@ static const char *const reject_names[WC_REJECT_REASONS] = {
     [WC_REJECT_UNKNOWN_ID] = "unknown_id", [WC_REJECT_FORMAT] = "format",
     [WC_REJECT_IMPLAUSIBLE] = "implausible", [WC_REJECT_OVERFLOW] = "overflow"};
 
-static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, const step_times_t *h)
+static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, uint32_t rx_dropped,
+                   const step_times_t *h)
 {
     static const double pct[] = {50.0, 90.0, 99.0, 99.9};
     if (json) {
-        fprintf(out, "{\n  \"frames_in\": %u,\n  \"frames_used\": %u,\n  \"frames_out\": %u,\n  \"tx_errors\": %llu,\n",
-                k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors);
+        fprintf(out, "{\n  \"frames_in\": %u,\n  \"frames_used\": %u,\n  \"frames_out\": %u,\n  \"tx_errors\": %llu,\n"
+                     "  \"rx_dropped_by_kernel\": %u,\n",
+                k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors, rx_dropped);
         fprintf(out, "  \"rejected\": {");
         for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, "%s\"%s\": %u", r ? ", " : "", reject_names[r], k->rejected[r]); }
         fprintf(out, "},\n  \"sensor_timeouts\": %u,\n  \"request_timeouts\": %u,\n  \"safe_steps\": %u,\n"
@@ -166,8 +168,8 @@ static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx
                 percentile_us(h, 99.9));
         return;
     }
-    fprintf(out, "wc_tcu: frames in %u (used %u), out %u, send errors %llu\n", k->frames_in, k->frames_used,
-            k->frames_out, (unsigned long long)tx_errors);
+    fprintf(out, "wc_tcu: frames in %u (used %u), out %u, send errors %llu, dropped by the kernel %u\n",
+            k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors, rx_dropped);
     fprintf(out, "wc_tcu: rejected:");
     for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, " %s %u", reject_names[r], k->rejected[r]); }
     fprintf(out, "\nwc_tcu: timeouts: sensors %u, request %u; steps %u (safe state %u); deadline misses %u\n",
@@ -257,14 +259,14 @@ int main(int argc, char **argv)
         record(&times, now_ns() - t0);
     }
     wc_socketcan_close(&port);
-    report(stderr, 0, &loop.counters, tx_errors, &times);
+    report(stderr, 0, &loop.counters, tx_errors, port.rx_dropped, &times);
     if (opt.stats_json != NULL) {
         FILE *f = fopen(opt.stats_json, "w");
         if (f == NULL) {
             fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
             return 1;
         }
-        report(f, 1, &loop.counters, tx_errors, &times);
+        report(f, 1, &loop.counters, tx_errors, port.rx_dropped, &times);
         if (fclose(f) != 0) {
             fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
             return 1;

@@ -1,0 +1,253 @@
+"""Replay a bench log to the TCU program on vcan and compare with the reference.
+
+Pieces, usable alone:
+  check_log      validate a candump -L log: parseable, time-ordered, no gaps,
+                 ids known (what is wrong is reported with its line)
+  run_on_vcan    hil/vcan_run.sh + hil/replay_guest.sh: wc_tcu on a live vcan0
+                 (native, or inside the QEMU guest), canplayer in, candump out
+  loop_reference the frame loop of src/wc_loop.c re-implemented here (E2E,
+                 plausibility, freshness, safe state) feeding model.clutch_steps
+  compare        the TCU's output frames against the reference, step by step
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import canlog, model
+from .calibration import Calibration
+
+ROOT = canlog.ROOT
+RX_NAMES = (canlog.SENSORS, canlog.REQUEST)      # what wc_tcu's kernel filter lets in
+STATUS_BITS = ("StatusSensorTimeout", "StatusRequestTimeout", "StatusCrcError", "StatusCounterError",
+               "StatusImplausibleInput", "StatusSaturated", "StatusCurrentClamped", "StatusBelowDrag",
+               "StatusSafeStateActive", "StatusDeadlineMiss")
+BIT = {name: 1 << i for i, name in enumerate(STATUS_BITS)}
+
+
+# --------------------------------------------------------------------------- log checks
+
+@dataclass
+class LogCheck:
+    frames: int = 0
+    by_name: dict = field(default_factory=dict)
+    unknown_ids: dict = field(default_factory=dict)     # id -> (count, first line)
+    out_of_order: list = field(default_factory=list)    # line numbers
+    gaps: list = field(default_factory=list)            # (line, gap_s)
+    span_s: float = 0.0
+
+    def problems(self) -> list[str]:
+        out = []
+        for ident, (count, line) in sorted(self.unknown_ids.items()):
+            out.append(f"unknown id 0x{ident:X}: {count} frame(s), first at line {line} (not in hil/wetclutch.dbc;"
+                       " the TCU's receive filter drops them)")
+        for line in self.out_of_order[:5]:
+            out.append(f"line {line}: timestamp earlier than the line before (out of order)")
+        if len(self.out_of_order) > 5:
+            out.append(f"... {len(self.out_of_order) - 5} more out-of-order lines")
+        for line, gap in self.gaps[:5]:
+            out.append(f"line {line}: {gap * 1e3:.1f} ms since the previous ClutchSensors frame (gap)")
+        if len(self.gaps) > 5:
+            out.append(f"... {len(self.gaps) - 5} more gaps")
+        return out
+
+
+def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> LogCheck:
+    """Raises canlog.LogError for a missing or malformed file; returns what it found."""
+    db = canlog.database()
+    messages = canlog.read_log(path)
+    if not messages:
+        raise canlog.LogError(f"{path}: empty log")
+    check = LogCheck(frames=len(messages), span_s=messages[-1].timestamp - messages[0].timestamp)
+    last_t = None
+    last_sensor_t = None
+    sensors_id = db.get_message_by_name(canlog.SENSORS).frame_id
+    for line, msg in enumerate(messages, start=1):
+        if last_t is not None and msg.timestamp < last_t:
+            check.out_of_order.append(line)
+        last_t = msg.timestamp
+        try:
+            name = db.get_message_by_frame_id(msg.arbitration_id).name
+        except KeyError:
+            count, first = check.unknown_ids.get(msg.arbitration_id, (0, line))
+            check.unknown_ids[msg.arbitration_id] = (count + 1, first)
+            continue
+        check.by_name[name] = check.by_name.get(name, 0) + 1
+        if msg.arbitration_id == sensors_id:
+            if last_sensor_t is not None and msg.timestamp - last_sensor_t > gap_periods * period_s:
+                check.gaps.append((line, msg.timestamp - last_sensor_t))
+            last_sensor_t = msg.timestamp
+    return check
+
+
+# --------------------------------------------------------------------------- running on vcan
+
+def run_on_vcan(log: Path, out_dir: Path, frame_runs: int = 2, timer_runs: int = 1,
+                tcu: Path | None = None) -> None:
+    """Boot/attach vcan0 and replay; progress goes to stderr. Raises on failure."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
+    if not tcu.is_file():
+        raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
+                                " cmake --build --preset host-release)")
+    log_abs = Path(log).resolve()
+    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out_dir.resolve()),
+           "--", "bash", str(ROOT / "hil" / "replay_guest.sh"), str(log_abs), str(out_dir.resolve()),
+           "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", str(tcu)]
+    env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
+    result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
+    if result.returncode != 0:
+        raise RuntimeError(f"replay on vcan failed (exit {result.returncode}); see the messages above and"
+                           f" {out_dir}/*.txt")
+
+
+# --------------------------------------------------------------------------- reference of the loop
+
+@dataclass
+class _Input:
+    timeout: int
+    age: int = 0
+    seen: bool = False
+    stale: bool = True
+    synced: bool = False
+    previous: int = 0
+
+    def counter_ok(self, counter: int) -> bool:
+        if not self.synced:
+            self.synced, self.previous = True, counter
+            return True
+        if counter == (self.previous + 1) % 16:
+            self.previous = counter
+            return True
+        if counter != self.previous:
+            self.previous = counter   # resynchronise on a jump
+        return False
+
+    def freshness(self) -> tuple[bool, bool]:
+        """(stale, timed_out_now), then one period older."""
+        stale = (not self.seen) or self.age >= self.timeout
+        timed_out = stale and not self.stale and self.seen
+        if timed_out:
+            self.seen, self.synced = False, False
+        self.stale = stale
+        self.age += 1
+        return stale, timed_out
+
+
+def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
+                   sensor_timeout: int = 10, request_timeout: int = 10) -> dict:
+    """What wc_tcu --clock frame computes for this sequence of received frames."""
+    db = canlog.database()
+    specs = {db.get_message_by_name(n).frame_id: db.get_message_by_name(n) for n in RX_NAMES}
+    sensors_id = db.get_message_by_name(canlog.SENSORS).frame_id
+    inputs = {n: _Input(sensor_timeout if n == canlog.SENSORS else request_timeout) for n in RX_NAMES}
+    held = {"SlipSpeed": 0.0, "OilTemp": theta_start_degC, "HousingTemp": theta_start_degC,
+            "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN)}
+    rejected = {k: 0 for k in ("crc", "counter", "short", "format", "implausible")}
+    pending = 0
+    rows = []
+    for msg in messages:
+        spec = specs.get(msg.arbitration_id)
+        if spec is None:
+            continue                      # the kernel filter of wc_tcu drops it
+        if msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame:
+            rejected["format"] += 1
+        elif len(msg.data) < 8:
+            rejected["short"] += 1
+        elif canlog.crc8_j1850(bytes([spec.frame_id & 0xFF]) + bytes(msg.data[1:8])) != msg.data[0]:
+            rejected["crc"] += 1
+            pending |= BIT["StatusCrcError"]
+        else:
+            state = inputs[spec.name]
+            values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
+            if not state.counter_ok(int(values["AliveCounter"])):
+                rejected["counter"] += 1
+                pending |= BIT["StatusCounterError"]
+            elif any(not (sig.minimum <= values[sig.name] <= sig.maximum)
+                     for sig in spec.signals if sig.name not in ("Crc", "AliveCounter")):
+                rejected["implausible"] += 1
+                pending |= BIT["StatusImplausibleInput"]
+            else:
+                state.age, state.seen = 0, True
+                held.update({k: float(v) for k, v in values.items() if k in held})
+        if msg.arbitration_id != sensors_id or msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame:
+            continue
+        bits, pending = pending, 0        # one step per ClutchSensors frame
+        s_stale, _ = inputs[canlog.SENSORS].freshness()
+        r_stale, _ = inputs[canlog.REQUEST].freshness()
+        bits |= BIT["StatusSensorTimeout"] if s_stale else 0
+        bits |= BIT["StatusRequestTimeout"] if r_stale else 0
+        safe = s_stale or r_stale
+        mode = {canlog.MODE_TORQUE_CONTROL: model.MODE_TORQUE, canlog.MODE_LOCKED: model.MODE_LOCKED}.get(
+            int(held["Mode"]), model.MODE_OPEN)
+        rows.append((held["SlipSpeed"], held["OilTemp"], held["HousingTemp"], held["TorqueRequest"],
+                     model.MODE_OPEN if safe else mode, bits | (BIT["StatusSafeStateActive"] if safe else 0)))
+    if not rows:
+        return {"steps": 0, "rejected": rejected}
+    slip, oil, housing, request, mode, bits = (np.array(c) for c in zip(*rows))
+    steps = model.clutch_steps(cal, slip, oil, housing, request, mode=mode.astype(int),
+                               theta_start_degC=theta_start_degC)
+    status = np.asarray(steps["status"])
+    bits = bits.astype(int)
+    bits |= np.where(status & model.STATUS_SATURATED, BIT["StatusSaturated"], 0)
+    bits |= np.where(status & model.STATUS_CURRENT_CLAMPED, BIT["StatusCurrentClamped"], 0)
+    bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
+    return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
+            "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
+
+
+def output_frames(capture) -> dict:
+    """VfsCommand and ClutchEstimate of a capture, with the status word rebuilt from its bits."""
+    decoded = canlog.decode(capture)
+    out = {}
+    for name in (canlog.COMMAND, canlog.ESTIMATE):
+        if name not in decoded:
+            raise canlog.LogError(f"the capture holds no {name} frame: did wc_tcu run?")
+        out[name] = decoded[name]
+    cmd = out[canlog.COMMAND]
+    cmd["status"] = sum(cmd[name].astype(int) << i for i, name in enumerate(STATUS_BITS))
+    return out
+
+
+def raw_payloads(capture, names=(canlog.COMMAND, canlog.ESTIMATE)) -> list[tuple[int, bytes]]:
+    db = canlog.database()
+    ids = {db.get_message_by_name(n).frame_id for n in names}
+    return [(m.arbitration_id, bytes(m.data)) for m in capture if m.arbitration_id in ids]
+
+
+def compare(reference: dict, outputs: dict) -> dict:
+    """Per-signal worst differences between the TCU's frames and the reference."""
+    cmd, est = outputs[canlog.COMMAND], outputs[canlog.ESTIMATE]
+    n = reference["steps"]
+    if len(cmd["VfsCurrent"]) != n or len(est["ModelTorque"]) != n:
+        raise canlog.LogError(f"step count differs: reference {n}, TCU VfsCommand {len(cmd['VfsCurrent'])},"
+                              f" ClutchEstimate {len(est['ModelTorque'])} (frames lost in capture?)")
+    pairs = {
+        "current_mA": (cmd["VfsCurrent"], reference["current_mA"]),
+        "pressure_command_kPa": (cmd["PressureCommand"], reference["pressure_command_Pa"] * 1e-3),
+        "theta_degC": (est["EstimatedClutchTemp"], reference["theta_degC"]),
+        "torque_Nm": (est["ModelTorque"], reference["torque_Nm"]),
+        "mu_f": (est["MuF"], reference["mu_f"]),
+        "hbar_um": (est["FilmThickness"], reference["hbar_m"] * 1e6),
+    }
+    result = {k: float(np.max(np.abs(a - b))) for k, (a, b) in pairs.items()}
+    result["status_mismatches"] = int(np.sum((cmd["status"] & ~BIT["StatusDeadlineMiss"]) != reference["status_bits"]))
+    result["steps"] = n
+    return result
+
+
+def load_stats(path: Path) -> dict:
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise canlog.LogError(f"{path}: wc_tcu statistics unreadable: {e}") from None
+
+
+def main_progress(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)
