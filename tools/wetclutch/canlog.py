@@ -118,15 +118,19 @@ def read_log(path: Path) -> list[can.Message]:
 
 def decode(messages, db=None) -> dict[str, dict[str, np.ndarray]]:
     """Decode every known frame into arrays of physical values per frame name,
-    plus '_t' (timestamps). Unknown ids are counted under '_unknown'."""
+    plus '_t' (timestamps). Unknown ids are counted under '_unknown', frames
+    of a known id with the wrong length under '_malformed': counted, not used."""
     db = db or database()
     rows: dict[str, list] = {}
-    unknown = 0
+    unknown = malformed = 0
     for msg in messages:
         try:
             spec = db.get_message_by_frame_id(msg.arbitration_id)
         except KeyError:
             unknown += 1
+            continue
+        if len(msg.data) != spec.length:
+            malformed += 1
             continue
         values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
         rows.setdefault(spec.name, []).append((msg.timestamp, values))
@@ -137,4 +141,5 @@ def decode(messages, db=None) -> dict[str, dict[str, np.ndarray]]:
             cols[key] = np.array([float(v[key]) for _, v in items])
         out[name] = cols
     out["_unknown"] = {"count": unknown}
+    out["_malformed"] = {"count": malformed}
     return out

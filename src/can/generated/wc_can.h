@@ -319,7 +319,7 @@ struct wc_can_vfs_command_t {
     uint8_t status_counter_error;
 
     /**
-     * Status bit 4: an input signal was SNA, outside its [min|max] range, or Mode was reserved; safe output active.
+     * Status bit 4: since the previous VfsCommand an input frame had a signal that was SNA, outside its [min|max] range, or a reserved Mode (the frame was dropped and the last valid value is held), or the model rejected an input. The safe state follows only if no valid frame arrives within the timeout.
      *
      * Range: 0..1 (0..1 -)
      * Scale: 1
@@ -355,7 +355,7 @@ struct wc_can_vfs_command_t {
     uint8_t status_below_drag;
 
     /**
-     * Status bit 8: the loop outputs its defined safe state (see the frame loop documentation) because of a timeout or an implausible input.
+     * Status bit 8: the loop outputs its defined safe state (minimum VFS current, clutch released; include/wc_loop.h) because an input timed out (no valid frame within its timeout: missing, corrupted or implausible frames).
      *
      * Range: 0..1 (0..1 -)
      * Scale: 1
