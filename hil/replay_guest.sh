@@ -41,7 +41,15 @@ one_run() { # clock name
   sleep 0.2  # candump's socket is bound by now too
   canplayer -I "$log" "$iface=$log_iface"
   wait $tcu_pid || rc=$?
-  sleep 0.2
+  # candump may lag behind the bus (slow in an emulated guest): stop it only
+  # once its capture has stopped growing, or it drops what it still queues.
+  local size=-1
+  for _ in $(seq 120); do
+    sleep 0.25
+    new=$(stat -c %s "$out/$name.log")
+    [ "$new" = "$size" ] && break
+    size=$new
+  done
   kill $dump_pid 2>/dev/null || true
   wait $dump_pid 2>/dev/null || true
   [ "$rc" = 0 ] || { cat "$out/$name.txt" >&2; die "wc_tcu exited with $rc ($name)"; }

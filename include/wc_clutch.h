@@ -4,6 +4,7 @@
 #ifndef WC_CLUTCH_H
 #define WC_CLUTCH_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "wc_inverse.h"
@@ -25,6 +26,11 @@ typedef struct {
     float theta_housing_degC;  /* housing temperature */
     float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
     wc_clutch_mode_t mode;
+    /* On a bench: the measured apply force (load cell). When valid, the torque
+     * model and the observer use it instead of the force of the modelled VFS
+     * pressure, as the paper's validation does (Fig. 14, 15). */
+    bool apply_force_measured_valid;
+    float apply_force_measured_N;
 } wc_step_input_t;
 
 typedef struct {
@@ -57,7 +63,8 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *     command; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
  *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
  *     WC_STATUS_TORQUE_INVALID);
- *  3. VFS lag -> modelled pressure -> contact force -> torque model;
+ *  3. VFS lag -> modelled pressure -> contact force (or the measured apply
+ *     force, when given and plausible) -> torque model;
  *  4. observer advanced with P = |T_model dw|.
  * out->theta_degC is the estimate before this step's update. */
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out);

@@ -19,6 +19,11 @@
  *  - The first valid frame after a timeout (its counter is taken as the new
  *    reference) ends the safe state for that input.
  *  - Before the first valid frame of each input the loop is in the safe state.
+ *  - BenchMeasurement (bench only, no E2E): while fresh (same timeout as the
+ *    sensors), its load-cell force replaces the modelled apply force in the
+ *    torque model and the observer (the paper's validation, Fig. 14/15); a
+ *    negative reading (load-cell noise at zero load) counts as 0 N. Stale or
+ *    absent, the modelled VFS pressure is used: no safe state, no status bit.
  */
 #ifndef WC_LOOP_H
 #define WC_LOOP_H
@@ -79,8 +84,10 @@ typedef struct {
     uint32_t rx_count;
     wc_loop_input_t sensors_in;
     wc_loop_input_t request_in;
+    wc_loop_input_t bench_in;
     wc_can_clutch_sensors_phys_t sensors;   /* last valid */
     wc_can_torque_request_phys_t request;   /* last valid */
+    wc_can_bench_measurement_phys_t bench;  /* last valid */
     uint16_t pending_status;                /* event bits for the next VfsCommand */
     uint8_t tx_alive;
     wc_loop_counters_t counters;
@@ -104,7 +111,8 @@ void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed);
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* Receive filter ids for the port (the frames wc_loop_receive uses). */
-#define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID }
-#define WC_LOOP_RX_ID_COUNT 2u
+#define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
+                         WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
+#define WC_LOOP_RX_ID_COUNT 3u
 
 #endif /* WC_LOOP_H */

@@ -63,7 +63,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 
     clutch->pressure_model_Pa = wc_vfs_lag_step(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
-    const float force_N = wc_contact_force_N(model->cal, clutch->pressure_model_Pa);
+    float force_N = wc_contact_force_N(model->cal, clutch->pressure_model_Pa);
+    if (in->apply_force_measured_valid) {
+        if (wc_in_range(in->apply_force_measured_N, 0.0f, WC_FORCE_MAX_N)) { force_N = in->apply_force_measured_N; }
+        else { status |= WC_STATUS_FORCE_INVALID; }  /* keep the modelled force */
+    }
     status |= wc_torque(model, u->slip_rad_s, clutch->theta_degC, force_N, &out->model);
 
     /* eq. 1 heat input: friction power |T dw| */

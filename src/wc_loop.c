@@ -24,6 +24,7 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     loop->config = *config;
     input_reset(&loop->sensors_in);
     input_reset(&loop->request_in);
+    input_reset(&loop->bench_in);
     loop->sensors.oil_temp_degC = theta_start_degC;
     loop->sensors.housing_temp_degC = theta_start_degC;
     loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
@@ -59,14 +60,14 @@ void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed)
     if (missed > 0u) { loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_DEADLINE_MISS); }
 }
 
-/* Map a decode result and the alive counter to use / reject. */
-static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, uint8_t alive)
+/* Map a decode result and (for E2E frames) the alive counter to use / reject. */
+static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, bool e2e, uint8_t alive)
 {
     if (decoded == WC_CAN_ERR_SIZE) { reject(loop, WC_REJECT_SHORT); return false; }
     if (decoded == WC_CAN_ERR_CRC) { reject(loop, WC_REJECT_CRC); return false; }
     /* The counter is checked before plausibility: an implausible frame still
      * proves the sender is alive and in sequence. */
-    if (!wc_e2e_counter_accepted(wc_e2e_counter_check(&in->alive, alive))) {
+    if (e2e && !wc_e2e_counter_accepted(wc_e2e_counter_check(&in->alive, alive))) {
         reject(loop, WC_REJECT_COUNTER);
         return false;
     }
@@ -84,13 +85,17 @@ static void process(wc_loop_t *loop, const wc_can_frame_t *f)
         return;
     }
     if (f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) {
-        wc_can_clutch_sensors_phys_t s;
+        wc_can_clutch_sensors_phys_t s = {0.0f, 0.0f, 0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_clutch_sensors(&s, f->data, f->dlc);
-        if (accept(loop, &loop->sensors_in, r, s.alive_counter)) { loop->sensors = s; }
+        if (accept(loop, &loop->sensors_in, r, true, s.alive_counter)) { loop->sensors = s; }
     } else if (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID) {
-        wc_can_torque_request_phys_t q;
+        wc_can_torque_request_phys_t q = {0.0f, 0u, 0u};
         const wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
-        if (accept(loop, &loop->request_in, r, q.alive_counter)) { loop->request = q; }
+        if (accept(loop, &loop->request_in, r, true, q.alive_counter)) { loop->request = q; }
+    } else if (f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) {
+        wc_can_bench_measurement_phys_t b = {0.0f, 0.0f, 0.0f};
+        const wc_can_result_t r = wc_can_decode_bench_measurement(&b, f->data, f->dlc);
+        if (accept(loop, &loop->bench_in, r, false, 0u)) { loop->bench = b; }
     } else {
         reject(loop, WC_REJECT_UNKNOWN_ID);
     }
@@ -145,6 +150,9 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
     const bool safe = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) != 0u;
+    uint32_t bench_timeouts = 0u;  /* bench frames are optional: staleness is not a fault */
+    const bool bench_fresh = !update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
+    const float load_cell_N = loop->bench.load_cell_force_N;
 
     const wc_step_input_t in = {
         .slip_rad_s = loop->sensors.slip_speed_rpm * WC_RAD_S_PER_RPM,
@@ -152,6 +160,8 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         .theta_housing_degC = loop->sensors.housing_temp_degC,
         .torque_request_Nm = loop->request.torque_request_Nm,
         .mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode),
+        .apply_force_measured_valid = bench_fresh,
+        .apply_force_measured_N = (load_cell_N > 0.0f) ? load_cell_N : 0.0f,
     };
     bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
     if (safe) {

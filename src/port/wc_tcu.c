@@ -3,7 +3,8 @@
  *   --clock timer  steps at absolute deadlines (clock_nanosleep), counts misses
  *   --clock frame  one step per received ClutchSensors frame, so that replaying
  *                  one log twice gives byte-identical output frames
- * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit idle seconds) it
+ * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit seconds without a
+ * frame after the first one) it
  * prints frames in/out, rejects by reason, timeouts, deadline misses and the
  * step-time max and percentiles, and optionally writes them as JSON. */
 #define _GNU_SOURCE
@@ -87,7 +88,7 @@ static void usage(FILE *out)
             "  -p, --period-us N         step period for --clock timer (default: the calibration's, 1000)\n"
             "  -k, --calibration NAME    compiled-in calibration (available: table1)\n"
             "  -n, --steps N             stop after N steps (default: run until SIGINT/SIGTERM)\n"
-            "  -I, --idle-exit S         stop after S seconds without any received frame\n"
+            "  -I, --idle-exit S         stop once no frame has arrived for S seconds (timed from the first frame)\n"
             "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
             "      --sensor-timeout N    ClutchSensors timeout in periods (default 10)\n"
             "      --request-timeout N   TorqueRequest timeout in periods (default 10)\n"
@@ -217,7 +218,7 @@ int main(int argc, char **argv)
 
     uint64_t tx_errors = 0;
     int status = 0;
-    int64_t last_rx = now_ns();
+    int64_t last_rx = -1;  /* the idle timer starts with the first frame */
     int64_t deadline = now_ns() + opt.period_ns;
     while (!stop_requested && (opt.max_steps == 0 || loop.counters.steps < opt.max_steps)) {
         int step_now = 0;
@@ -234,7 +235,7 @@ int main(int argc, char **argv)
             last_rx = t;
             (void)wc_loop_receive(&loop, &frame);
             step_now = opt.frame_clock && (frame.id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && frame.flags == 0u;
-        } else if (opt.idle_exit_s > 0 && (double)(t - last_rx) > opt.idle_exit_s * 1e9) {
+        } else if (opt.idle_exit_s > 0 && last_rx >= 0 && (double)(t - last_rx) > opt.idle_exit_s * 1e9) {
             break;
         }
         if (!opt.frame_clock && t >= deadline) {

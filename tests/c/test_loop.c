@@ -887,9 +887,9 @@ static void test_short_unknown_and_format(void **state)
     (void)good_period(fx, &NOMINAL, 0u);
     check_rejected_only(&fx->loop, WC_REJECT_SHORT, 1u);
 
-    /* Unknown ids: BenchMeasurement (not for the loop), our own VfsCommand
-     * echoed back, an id nobody uses. None steps the frame clock. */
-    wc_can_frame_t bench = empty_frame(WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
+    /* Unknown ids: a bench frame under an id the DBC does not define, our own
+     * VfsCommand echoed back, an id nobody uses. None steps the frame clock. */
+    wc_can_frame_t bench = empty_frame(WC_CAN_BENCH_MEASUREMENT_FRAME_ID + 1u);
     const wc_can_bench_measurement_phys_t m = { 1000.0f, 100.0f, 60.0f };
     assert_int_equal(wc_can_encode_bench_measurement(bench.data, &m, sizeof bench.data), WC_CAN_OK);
     port_deliver(&bench);
@@ -1129,7 +1129,7 @@ static void build_engagement(script_t *s, float torque_change_Nm)
         }
         r_alive = wc_e2e_counter_next(r_alive);
         if (k == 180) {
-            wc_can_frame_t bench = empty_frame(WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
+            wc_can_frame_t bench = empty_frame(WC_CAN_BENCH_MEASUREMENT_FRAME_ID + 1u);  /* not in the DBC */
             const wc_can_bench_measurement_phys_t m = { 5000.0f, 250.0f, 95.0f };
             assert_int_equal(wc_can_encode_bench_measurement(bench.data, &m, sizeof bench.data), WC_CAN_OK);
             script_add(s, &bench, WC_REJECT_UNKNOWN_ID);
@@ -1250,6 +1250,75 @@ static void test_counters_add_up(void **state)
     for (int r = 0; r < (int)WC_REJECT_OVERFLOW; ++r) { assert_int_equal(engagement.bad[r], 1u); }
 }
 
+
+/* ---- bench mode ------------------------------------------------------------
+ * A fresh BenchMeasurement replaces the modelled apply force in the torque
+ * model (the paper's validation); stale, the modelled VFS pressure is back.
+ * Expectations from wc_torque at the force the policy names, with the
+ * loop's own temperature estimate of that step. */
+
+static void bench_period(fixture_t *fx, const float *load_N)
+{
+    good_request(fx, NOMINAL.torque_Nm, NOMINAL.mode);
+    if (load_N != NULL) {
+        wc_can_frame_t b = empty_frame(WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
+        const wc_can_bench_measurement_phys_t m = { *load_N, 100.0f, 60.0f };
+        assert_int_equal(wc_can_encode_bench_measurement(b.data, &m, sizeof b.data), WC_CAN_OK);
+        port_deliver(&b);
+    }
+    good_sensors(fx, NOMINAL.slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC);
+    run_steps(&fx->loop, 1u);
+}
+
+static void check_model_torque_at(const fixture_t *fx, long k, float force_N)
+{
+    wc_torque_t t;
+    assert_int_equal(wc_torque(&fx->loop.clutch.model, NOMINAL.slip_rpm * WC_RAD_S_PER_RPM, fx->loop.last.theta_degC,
+                               force_N, &t), WC_STATUS_OK);
+    wc_can_vfs_command_phys_t cmd;
+    wc_can_clutch_estimate_phys_t est;
+    last_outputs(&cmd, &est);
+    /* tolerance: one raw step of ModelTorque (0.1 Nm); same float arithmetic otherwise */
+    WC_CHECK_CLOSE("ModelTorque at the policy's force", k, est.model_torque_Nm, t.torque_Nm, 0.0,
+                   (double)wc_can_sig_clutch_estimate_model_torque.scale);
+}
+
+static void test_bench_force_replaces_modelled_force(void **state)
+{
+    fixture_t *fx = *state;
+    const wc_calibration_t *cal = &wc_table1_calibration;
+    for (int k = 0; k < 5; ++k) { bench_period(fx, NULL); }
+    const float load_N = 1188.0f;
+    for (long k = 0; k < 30; ++k) {
+        bench_period(fx, &load_N);
+        check_model_torque_at(fx, k, 1188.0f);  /* 0.1 N/bit: 1188 N is exact */
+    }
+    /* The modelled force differs clearly, so a loop ignoring the bench fails above. */
+    const float modelled_N = wc_contact_force_N(cal, fx->loop.clutch.pressure_model_Pa);
+    WC_CHECK(fabsf(modelled_N - load_N) > 50.0f, "modelled force %g N too close to the load %g N",
+             (double)modelled_N, (double)load_N);
+    /* A negative reading (noise at zero load) counts as 0 N. */
+    const float negative_N = -3.0f;
+    bench_period(fx, &negative_N);
+    check_model_torque_at(fx, 100, 0.0f);
+    /* Bench frames stop: fresh for sensor_timeout periods, then the modelled pressure. */
+    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    for (uint32_t k = 0u; k + 1u < config.sensor_timeout_periods; ++k) {
+        bench_period(fx, NULL);
+        check_model_torque_at(fx, 200 + (long)k, 0.0f);
+    }
+    for (long k = 0; k < 5; ++k) {
+        bench_period(fx, NULL);
+        check_model_torque_at(fx, 300 + k, wc_contact_force_N(cal, fx->loop.clutch.pressure_model_Pa));
+        wc_can_vfs_command_phys_t cmd;
+        wc_can_clutch_estimate_phys_t est;
+        last_outputs(&cmd, &est);
+        WC_CHECK((cmd.status & (WC_CAN_STATUS_SAFE_STATE_ACTIVE | WC_CAN_STATUS_IMPLAUSIBLE_INPUT)) == 0u,
+                 "bench staleness must not raise a fault (status 0x%x)", (unsigned)cmd.status);
+    }
+    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_UNKNOWN_ID], 0u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1268,6 +1337,7 @@ int main(void)
         cmocka_unit_test_setup(test_persistent_implausible_sensor, setup),
         cmocka_unit_test_setup(test_frame_clock_determinism, setup),
         cmocka_unit_test_setup(test_counters_add_up, setup),
+        cmocka_unit_test_setup(test_bench_force_replaces_modelled_force, setup),
     };
     return cmocka_run_group_tests_name("wc_loop", tests, NULL, NULL);
 }

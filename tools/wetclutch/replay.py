@@ -24,7 +24,7 @@ from . import canlog, model
 from .calibration import Calibration
 
 ROOT = canlog.ROOT
-RX_NAMES = (canlog.SENSORS, canlog.REQUEST)      # what wc_tcu's kernel filter lets in
+RX_NAMES = (canlog.SENSORS, canlog.REQUEST, canlog.BENCH)  # what wc_tcu's kernel filter lets in
 STATUS_BITS = ("StatusSensorTimeout", "StatusRequestTimeout", "StatusCrcError", "StatusCounterError",
                "StatusImplausibleInput", "StatusSaturated", "StatusCurrentClamped", "StatusBelowDrag",
                "StatusSafeStateActive", "StatusDeadlineMiss")
@@ -146,9 +146,10 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
     db = canlog.database()
     specs = {db.get_message_by_name(n).frame_id: db.get_message_by_name(n) for n in RX_NAMES}
     sensors_id = db.get_message_by_name(canlog.SENSORS).frame_id
-    inputs = {n: _Input(sensor_timeout if n == canlog.SENSORS else request_timeout) for n in RX_NAMES}
+    inputs = {n: _Input(request_timeout if n == canlog.REQUEST else sensor_timeout) for n in RX_NAMES}
     held = {"SlipSpeed": 0.0, "OilTemp": theta_start_degC, "HousingTemp": theta_start_degC,
-            "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN)}
+            "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN), "LoadCellForce": 0.0}
+    e2e = set(canlog.E2E_FRAMES)
     rejected = {k: 0 for k in ("crc", "counter", "short", "format", "implausible")}
     pending = 0
     rows = []
@@ -160,17 +161,18 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
             rejected["format"] += 1
         elif len(msg.data) < 8:
             rejected["short"] += 1
-        elif canlog.crc8_j1850(bytes([spec.frame_id & 0xFF]) + bytes(msg.data[1:8])) != msg.data[0]:
+        elif spec.name in e2e and canlog.crc8_j1850(bytes([spec.frame_id & 0xFF]) + bytes(msg.data[1:8])) != msg.data[0]:
             rejected["crc"] += 1
             pending |= BIT["StatusCrcError"]
         else:
             state = inputs[spec.name]
             values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
-            if not state.counter_ok(int(values["AliveCounter"])):
+            if spec.name in e2e and not state.counter_ok(int(values["AliveCounter"])):
                 rejected["counter"] += 1
                 pending |= BIT["StatusCounterError"]
             elif any(not (sig.minimum <= values[sig.name] <= sig.maximum)
                      for sig in spec.signals if sig.name not in ("Crc", "AliveCounter")):
+                # plausibility: every signal inside its DBC [min|max] (SNA values lie outside)
                 rejected["implausible"] += 1
                 pending |= BIT["StatusImplausibleInput"]
             else:
@@ -181,24 +183,27 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
         bits, pending = pending, 0        # one step per ClutchSensors frame
         s_stale, _ = inputs[canlog.SENSORS].freshness()
         r_stale, _ = inputs[canlog.REQUEST].freshness()
+        b_stale, _ = inputs[canlog.BENCH].freshness()   # optional input: staleness is no fault
         bits |= BIT["StatusSensorTimeout"] if s_stale else 0
         bits |= BIT["StatusRequestTimeout"] if r_stale else 0
         safe = s_stale or r_stale
         mode = {canlog.MODE_TORQUE_CONTROL: model.MODE_TORQUE, canlog.MODE_LOCKED: model.MODE_LOCKED}.get(
             int(held["Mode"]), model.MODE_OPEN)
         rows.append((held["SlipSpeed"], held["OilTemp"], held["HousingTemp"], held["TorqueRequest"],
-                     model.MODE_OPEN if safe else mode, bits | (BIT["StatusSafeStateActive"] if safe else 0)))
+                     model.MODE_OPEN if safe else mode, bits | (BIT["StatusSafeStateActive"] if safe else 0),
+                     np.nan if b_stale else max(held["LoadCellForce"], 0.0)))
     if not rows:
         return {"steps": 0, "rejected": rejected}
-    slip, oil, housing, request, mode, bits = (np.array(c) for c in zip(*rows))
+    slip, oil, housing, request, mode, bits, load = (np.array(c) for c in zip(*rows))
     steps = model.clutch_steps(cal, slip, oil, housing, request, mode=mode.astype(int),
-                               theta_start_degC=theta_start_degC)
+                               theta_start_degC=theta_start_degC, apply_force_measured_N=load)
     status = np.asarray(steps["status"])
     bits = bits.astype(int)
     bits |= np.where(status & model.STATUS_SATURATED, BIT["StatusSaturated"], 0)
     bits |= np.where(status & model.STATUS_CURRENT_CLAMPED, BIT["StatusCurrentClamped"], 0)
     bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
     return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
+            "apply_force_measured_N": load,
             "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
 
 
