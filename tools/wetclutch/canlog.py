@@ -15,6 +15,8 @@ import can
 import cantools
 import numpy as np
 
+from .errors import LogError
+
 ROOT = Path(__file__).resolve().parents[2]
 DBC_PATH = ROOT / "hil" / "wetclutch.dbc"
 
@@ -24,8 +26,6 @@ E2E_FRAMES = (SENSORS, REQUEST, COMMAND)
 MODE_OPEN, MODE_TORQUE_CONTROL, MODE_LOCKED = 0, 1, 2
 
 
-class LogError(Exception):
-    """A log that cannot be used; the message says where."""
 
 
 def database(path: Path = DBC_PATH) -> cantools.database.Database:
@@ -79,9 +79,10 @@ def write_log(path: Path, messages: list[tuple[float, can.Message]], channel: st
 
 def input_log(t_s, slip_rpm, oil_degC, housing_degC, request_Nm, mode=MODE_TORQUE_CONTROL,
               bench=None, start_s: float = 1.0e6):
-    """Frames the TCU receives, one period per row: TorqueRequest then ClutchSensors
-    (so each step sees that period's request), then BenchMeasurement if given
-    (dict of arrays load_cell_N, torque_Nm, thermistor_degC)."""
+    """Frames the TCU receives, one period per row: TorqueRequest, BenchMeasurement
+    if given (dict of arrays load_cell_N, torque_Nm, thermistor_degC), then
+    ClutchSensors last, so that the step it triggers (frame clock) sees that
+    period's request and measurement."""
     enc = Encoder()
     n = len(t_s)
     modes = np.broadcast_to(np.asarray(mode), (n,))
@@ -89,12 +90,12 @@ def input_log(t_s, slip_rpm, oil_degC, housing_degC, request_Nm, mode=MODE_TORQU
     for k in range(n):
         stamp = start_s + float(t_s[k])
         out.append((stamp, enc.frame(REQUEST, TorqueRequest=float(request_Nm[k]), Mode=int(modes[k]))))
-        out.append((stamp + 2e-6, enc.frame(SENSORS, SlipSpeed=float(slip_rpm[k]), OilTemp=float(oil_degC[k]),
-                                            HousingTemp=float(housing_degC[k]))))
         if bench is not None:
-            out.append((stamp + 4e-6, enc.frame(BENCH, LoadCellForce=float(bench["load_cell_N"][k]),
+            out.append((stamp + 2e-6, enc.frame(BENCH, LoadCellForce=float(bench["load_cell_N"][k]),
                                                 MeasuredTorque=float(bench["torque_Nm"][k]),
                                                 ClutchThermistorTemp=float(bench["thermistor_degC"][k]))))
+        out.append((stamp + 4e-6, enc.frame(SENSORS, SlipSpeed=float(slip_rpm[k]), OilTemp=float(oil_degC[k]),
+                                            HousingTemp=float(housing_degC[k]))))
     return out
 
 

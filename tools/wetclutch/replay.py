@@ -88,23 +88,34 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 
 # --------------------------------------------------------------------------- running on vcan
 
-def run_on_vcan(log: Path, out_dir: Path, frame_runs: int = 2, timer_runs: int = 1,
-                tcu: Path | None = None) -> None:
-    """Boot/attach vcan0 and replay; progress goes to stderr. Raises on failure."""
-    out_dir.mkdir(parents=True, exist_ok=True)
+def run_on_vcan(log, out_dir, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
+                jobs=None) -> None:
+    """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
+    of jobs (default: the one log given). Progress goes to stderr. Raises on failure."""
+    jobs = list(jobs) if jobs is not None else [(Path(log), Path(out_dir))]
     tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
     if not tcu.is_file():
         raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
                                 " cmake --build --preset host-release)")
-    log_abs = Path(log).resolve()
-    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out_dir.resolve()),
-           "--", "bash", str(ROOT / "hil" / "replay_guest.sh"), str(log_abs), str(out_dir.resolve()),
-           "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", str(tcu)]
+    script = []
+    rw = []
+    for job_log, job_out in jobs:
+        job_out = Path(job_out).resolve()
+        job_out.mkdir(parents=True, exist_ok=True)
+        rw += ["--rwdir", str(job_out)]
+        script.append(" ".join(["bash", _q(ROOT / "hil" / "replay_guest.sh"), _q(Path(job_log).resolve()), _q(job_out),
+                                "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", _q(tcu)]))
+    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
     if result.returncode != 0:
         raise RuntimeError(f"replay on vcan failed (exit {result.returncode}); see the messages above and"
-                           f" {out_dir}/*.txt")
+                           f" the wc_tcu logs (*.txt) in {', '.join(str(o) for _, o in jobs)}")
+
+
+def _q(path) -> str:
+    import shlex
+    return shlex.quote(str(path))
 
 
 # --------------------------------------------------------------------------- reference of the loop
