@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from wetclutch import canlog
+
 cantools = pytest.importorskip("cantools")
 from cantools.database.can.c_source import camel_to_snake_case  # noqa: E402
 
@@ -44,19 +46,9 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
 UNSCALED = {"Crc", "AliveCounter", "Mode", *STATUS_BITS}
 
 
-def crc8_j1850(data: bytes) -> int:
-    """CRC-8 SAE J1850: poly 0x1D, init 0xFF, xor-out 0xFF (independent of the C code)."""
-    crc = 0xFF
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
-    return crc ^ 0xFF
-
-
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
-    crc = crc8_j1850(bytes([frame_id & 0xFF]) + data[1:8])
-    return bytes([crc]) + data[1:]
+    """The E2E CRC by the Python side (wetclutch.canlog, independent of the C code)."""
+    return bytes(canlog.protect(frame_id, bytearray(data)))
 
 
 def f32(x: float) -> float:
@@ -166,10 +158,10 @@ def test_mode_values(db):
 
 
 def test_crc8_vectors():
-    assert crc8_j1850(bytes([0, 0, 0, 0])) == 0x59
-    assert crc8_j1850(bytes([0xF2, 0x01, 0x83])) == 0x37
-    assert crc8_j1850(bytes([0x0F, 0xAA, 0x00, 0x55])) == 0x79
-    assert crc8_j1850(b"123456789") == 0x4B
+    assert canlog.crc8_j1850(bytes([0, 0, 0, 0])) == 0x59
+    assert canlog.crc8_j1850(bytes([0xF2, 0x01, 0x83])) == 0x37
+    assert canlog.crc8_j1850(bytes([0x0F, 0xAA, 0x00, 0x55])) == 0x79
+    assert canlog.crc8_j1850(b"123456789") == 0x4B
 
 
 # ---- the generated codec -----------------------------------------------------
