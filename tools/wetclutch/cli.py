@@ -79,6 +79,31 @@ def _cmd_replay(args) -> int:
     return 0
 
 
+def _cmd_bench(args) -> int:
+    import time
+    from . import bench  # the simulator only when needed
+    start = time.monotonic()
+    out = bench.run(args.experiment, args.out, true_path=args.true, seed=args.seed, slips_rpm=args.slip,
+                    logs=True if args.logs else None)
+    for r in out["results"]:
+        if r.experiment.kind == "engagement":
+            f = bench.engagement_figures(r)
+            print(f"{r.experiment.name}: contact {f['t_contact_s']:.3f} s, lock {f['t_lock_s']:.3f} s,"
+                  f" peak torque {f['peak_torque_Nm']:.1f} Nm, peak viscous {f['peak_viscous_Nm']:.1f} Nm")
+    print(f"wrote {len(out['files'])} files to {args.out} ({len(out['results'])} experiment(s), seed {args.seed},"
+          f" true parameters {args.true}) in {time.monotonic() - start:.1f} s")
+    return 0
+
+
+def _cmd_convert(args) -> int:
+    from . import bench
+    stats = bench.convert_log(args.input, args.output, channel=args.channel)
+    skipped = ", ".join(f"{v} {k}" for k, v in stats["skipped"].items() if v)
+    print(f"wrote {args.output}: {stats['frames']} frames over {stats['span_s']:.3f} s"
+          + (f" (skipped: {skipped} frame(s))" if skipped else ""))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="wetclutch", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
@@ -108,6 +133,25 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--no-reference-check", action="store_true",
                    help="skip comparing every TCU step with the double-precision reference")
     q.set_defaults(func=_cmd_replay)
+
+    q = sub.add_parser("bench", help="simulate the test bench (DESIGN 7): measurement CSVs and CAN logs")
+    q.add_argument("experiment", choices=("engagement", "table2", "thermal"),
+                   help="engagement (Fig. 15), table2 (the 184-experiment campaign), thermal (Fig. 13)")
+    q.add_argument("--out", required=True, help="output directory")
+    q.add_argument("--true", default="tools/calibrations/bench_true.toml",
+                   help="the bench's true parameters (calibration TOML; default tools/calibrations/bench_true.toml)")
+    q.add_argument("--seed", default="1", help="noise seed, a whole number >= 0 (default 1)")
+    q.add_argument("--slip", type=float, action="append", metavar="RPM",
+                   help="engagement initial slip, repeatable (default 750, 500 and 250 rpm)")
+    q.add_argument("--logs", action="store_true",
+                   help="table2/thermal: also write the 1 ms CAN logs (and 1 ms CSVs); slow and large")
+    q.set_defaults(func=_cmd_bench)
+
+    q = sub.add_parser("convert", help="convert a Vector ASC/BLF log to candump -L (for canplayer)")
+    q.add_argument("input", help="Vector .asc or .blf log")
+    q.add_argument("output", help="candump -L log to write")
+    q.add_argument("--channel", default="vcan0", help="interface name written in the log (default vcan0)")
+    q.set_defaults(func=_cmd_convert)
     return p
 
 
