@@ -20,17 +20,24 @@ typedef enum {
     WC_MODE_LOCKED = 2   /* maximum current: clutch locked */
 } wc_clutch_mode_t;
 
+/* On a test bench, measurements the vehicle does not have. When valid, the
+ * torque model uses the measured apply force (load cell) instead of the force
+ * of the modelled VFS pressure, and the observer takes its heat input from the
+ * measured torque: the paper validates the torque model (Fig. 15) and the
+ * temperature estimate (Fig. 14) this way. */
+typedef struct {
+    bool valid;
+    float apply_force_N;       /* load cell, >= 0 */
+    float torque_Nm;           /* torque sensor, signed like the slip */
+} wc_bench_input_t;
+
 typedef struct {
     float slip_rad_s;          /* clutch slip speed dw, signed */
     float theta_oil_degC;      /* oil (sump) temperature */
     float theta_housing_degC;  /* housing temperature */
     float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
     wc_clutch_mode_t mode;
-    /* On a bench: the measured apply force (load cell). When valid, the torque
-     * model and the observer use it instead of the force of the modelled VFS
-     * pressure, as the paper's validation does (Fig. 14, 15). */
-    bool apply_force_measured_valid;
-    float apply_force_measured_N;
+    wc_bench_input_t bench;    /* zero-initialized: not on a bench */
 } wc_step_input_t;
 
 typedef struct {
@@ -63,9 +70,10 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *     command; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
  *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
  *     WC_STATUS_TORQUE_INVALID);
- *  3. VFS lag -> modelled pressure -> contact force (or the measured apply
- *     force, when given and plausible) -> torque model;
- *  4. observer advanced with P = |T_model dw|.
+ *  3. VFS lag -> modelled pressure -> contact force (on a bench: the measured
+ *     apply force) -> torque model;
+ *  4. observer advanced with P = |T dw|, T the model torque (on a bench: the
+ *     measured torque). Implausible bench values are flagged and not used.
  * out->theta_degC is the estimate before this step's update. */
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out);
 

@@ -21,9 +21,11 @@
  *  - Before the first valid frame of each input the loop is in the safe state.
  *  - BenchMeasurement (bench only, no E2E): while fresh (same timeout as the
  *    sensors), its load-cell force replaces the modelled apply force in the
- *    torque model and the observer (the paper's validation, Fig. 14/15); a
- *    negative reading (load-cell noise at zero load) counts as 0 N. Stale or
- *    absent, the modelled VFS pressure is used: no safe state, no status bit.
+ *    torque model and its measured torque gives the observer's heat input
+ *    (the paper's validation, Fig. 14/15; wc_bench_input_t); a negative force
+ *    reading (load-cell noise at zero load) counts as 0 N. Stale or absent,
+ *    the modelled VFS pressure and model torque are used: no safe state, no
+ *    status bit.
  */
 #ifndef WC_LOOP_H
 #define WC_LOOP_H

@@ -64,14 +64,17 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     clutch->pressure_model_Pa = wc_vfs_lag_step(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_N(model->cal, clutch->pressure_model_Pa);
-    if (in->apply_force_measured_valid) {
-        if (wc_in_range(in->apply_force_measured_N, 0.0f, WC_FORCE_MAX_N)) { force_N = in->apply_force_measured_N; }
-        else { status |= WC_STATUS_FORCE_INVALID; }  /* keep the modelled force */
-    }
+    const bool bench_force = in->bench.valid && wc_in_range(in->bench.apply_force_N, 0.0f, WC_FORCE_MAX_N);
+    const bool bench_torque = in->bench.valid &&
+                              wc_in_range(in->bench.torque_Nm, -WC_TORQUE_MAX_Nm, WC_TORQUE_MAX_Nm);
+    if (in->bench.valid && !bench_force) { status |= WC_STATUS_FORCE_INVALID; }
+    if (in->bench.valid && !bench_torque) { status |= WC_STATUS_TORQUE_INVALID; }
+    if (bench_force) { force_N = in->bench.apply_force_N; }
     status |= wc_torque(model, u->slip_rad_s, clutch->theta_degC, force_N, &out->model);
 
     /* eq. 1 heat input: friction power |T dw| */
-    const float power_W = fabsf(out->model.torque_Nm * u->slip_rad_s);
+    const float heat_torque_Nm = bench_torque ? in->bench.torque_Nm : out->model.torque_Nm;
+    const float power_W = fabsf(heat_torque_Nm * u->slip_rad_s);
     status |= wc_thermal_step(model, &clutch->theta_degC, power_W, u->theta_oil_degC, u->theta_housing_degC);
     out->status = status;
     return status;

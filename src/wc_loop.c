@@ -160,8 +160,7 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         .theta_housing_degC = loop->sensors.housing_temp_degC,
         .torque_request_Nm = loop->request.torque_request_Nm,
         .mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode),
-        .apply_force_measured_valid = bench_fresh,
-        .apply_force_measured_N = (load_cell_N > 0.0f) ? load_cell_N : 0.0f,
+        .bench = { bench_fresh, (load_cell_N > 0.0f) ? load_cell_N : 0.0f, loop->bench.measured_torque_Nm },
     };
     bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
     if (safe) {

@@ -1290,8 +1290,19 @@ static void test_bench_force_replaces_modelled_force(void **state)
     for (int k = 0; k < 5; ++k) { bench_period(fx, NULL); }
     const float load_N = 1188.0f;
     for (long k = 0; k < 30; ++k) {
+        const float theta_before = fx->loop.clutch.theta_degC;
         bench_period(fx, &load_N);
         check_model_torque_at(fx, k, 1188.0f);  /* 0.1 N/bit: 1188 N is exact */
+        /* The observer's heat input is the measured torque (100 Nm in bench_period). */
+        float theta_expected = theta_before;
+        assert_int_equal(wc_thermal_step(&fx->loop.clutch.model, &theta_expected,
+                                         fabsf(100.0f * fx->loop.sensors.slip_speed_rpm * WC_RAD_S_PER_RPM),
+                                         fx->loop.sensors.oil_temp_degC, fx->loop.sensors.housing_temp_degC),
+                         WC_STATUS_OK);
+        /* same float operations in the same order: equal to within float rounding of one step */
+        WC_CHECK(fabsf(fx->loop.clutch.theta_degC - theta_expected) < 1e-5f,
+                 "step %ld: observer %g, expected with the measured torque %g", k,
+                 (double)fx->loop.clutch.theta_degC, (double)theta_expected);
     }
     /* The modelled force differs clearly, so a loop ignoring the bench fails above. */
     const float modelled_N = wc_contact_force_N(cal, fx->loop.clutch.pressure_model_Pa);

@@ -221,16 +221,16 @@ MODE_TORQUE, MODE_OPEN, MODE_LOCKED = 0, 1, 2
 
 
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
-                 mode=None, theta_start_degC=None, apply_force_measured_N=None):
+                 mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None):
     """The firmware's wc_clutch_step, composed in double precision, one row per period.
 
     Per step k: inverse at theta[k] (or the solenoid's minimum/maximum current
     for the open/locked modes) -> current; VFS lag (exact, tau) -> reached
     pressure -> contact force F = max(P A_p - F_s, 0) -> model torque;
     observer advanced with |T dw|. Returns a dict of arrays; theta_degC[k] is
-    the estimate used in step k (before its update). Where apply_force_measured_N
-    is given and not NaN (a bench's load cell), the torque model and the
-    observer use it instead of the force of the modelled pressure.
+    the estimate used in step k (before its update). On a bench (rows where
+    bench_force_N / bench_torque_Nm are given and not NaN) the torque model
+    uses the measured force and the observer's heat input the measured torque.
     """
     slip = np.asarray(slip_rpm, dtype=float)
     n = slip.size
@@ -238,8 +238,9 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     housing = np.broadcast_to(np.asarray(theta_housing_degC, dtype=float), (n,))
     request = np.broadcast_to(np.asarray(torque_request_Nm, dtype=float), (n,))
     modes = np.broadcast_to(np.asarray(MODE_TORQUE if mode is None else mode), (n,))
-    measured = np.broadcast_to(np.asarray(np.nan if apply_force_measured_N is None else apply_force_measured_N,
-                                          dtype=float), (n,))
+    def optional(x):
+        return np.broadcast_to(np.asarray(np.nan if x is None else x, dtype=float), (n,))
+    measured, measured_torque = optional(bench_force_N), optional(bench_torque_Nm)
     a_th = thermal_decay(cal, cal.period)
     a_vfs = math.exp(-cal.period / cal.vfs_time_constant)
     theta = float(oil[0]) if theta_start_degC is None else float(theta_start_degC)
@@ -263,7 +264,8 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
             force = measured[k]
         parts = torque_parts(cal, slip[k], theta, force)
         torque = float(parts["torque_Nm"])
-        power = abs(torque * slip[k] * RAD_S_PER_RPM)
+        heat_torque = torque if math.isnan(measured_torque[k]) else measured_torque[k]
+        power = abs(heat_torque * slip[k] * RAD_S_PER_RPM)
         steady = float(thermal_steady_degC(cal, power, oil[k], housing[k]))
         theta = steady + (theta - steady) * a_th
         for key, value in (("current_mA", current), ("pressure_command_Pa", target), ("pressure_model_Pa", pressure),

@@ -159,7 +159,7 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
     sensors_id = db.get_message_by_name(canlog.SENSORS).frame_id
     inputs = {n: _Input(request_timeout if n == canlog.REQUEST else sensor_timeout) for n in RX_NAMES}
     held = {"SlipSpeed": 0.0, "OilTemp": theta_start_degC, "HousingTemp": theta_start_degC,
-            "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN), "LoadCellForce": 0.0}
+            "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN), "LoadCellForce": 0.0, "MeasuredTorque": 0.0}
     e2e = set(canlog.E2E_FRAMES)
     rejected = {k: 0 for k in ("crc", "counter", "short", "format", "implausible")}
     pending = 0
@@ -202,19 +202,21 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
             int(held["Mode"]), model.MODE_OPEN)
         rows.append((held["SlipSpeed"], held["OilTemp"], held["HousingTemp"], held["TorqueRequest"],
                      model.MODE_OPEN if safe else mode, bits | (BIT["StatusSafeStateActive"] if safe else 0),
-                     np.nan if b_stale else max(held["LoadCellForce"], 0.0)))
+                     np.nan if b_stale else max(held["LoadCellForce"], 0.0),
+                     np.nan if b_stale else held["MeasuredTorque"]))
     if not rows:
         return {"steps": 0, "rejected": rejected}
-    slip, oil, housing, request, mode, bits, load = (np.array(c) for c in zip(*rows))
+    slip, oil, housing, request, mode, bits, load, measured_torque = (np.array(c) for c in zip(*rows))
     steps = model.clutch_steps(cal, slip, oil, housing, request, mode=mode.astype(int),
-                               theta_start_degC=theta_start_degC, apply_force_measured_N=load)
+                               theta_start_degC=theta_start_degC, bench_force_N=load,
+                               bench_torque_Nm=measured_torque)
     status = np.asarray(steps["status"])
     bits = bits.astype(int)
     bits |= np.where(status & model.STATUS_SATURATED, BIT["StatusSaturated"], 0)
     bits |= np.where(status & model.STATUS_CURRENT_CLAMPED, BIT["StatusCurrentClamped"], 0)
     bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
     return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
-            "apply_force_measured_N": load,
+            "bench_force_N": load, "bench_torque_Nm": measured_torque,
             "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
 
 
