@@ -19,7 +19,7 @@
 
 #include "wc_loop.h"
 #include "wc_socketcan.h"
-#include "wc_table1_calibration.h"
+#include "wc_tcu_calibrations.h"
 
 /* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
 #define HIST_BIN_NS 1000
@@ -86,7 +86,7 @@ static void usage(FILE *out)
             "  -c, --clock timer|frame   timer: fixed period, absolute deadlines (default);\n"
             "                            frame: one step per ClutchSensors frame (deterministic replay)\n"
             "  -p, --period-us N         step period for --clock timer (default: the calibration's, 1000)\n"
-            "  -k, --calibration NAME    compiled-in calibration (available: table1)\n"
+            "  -k, --calibration NAME    compiled-in calibration (default table1; --help lists them)\n"
             "  -n, --steps N             stop after N steps (default: run until SIGINT/SIGTERM)\n"
             "  -I, --idle-exit S         stop once no frame has arrived for S seconds (timed from the first frame)\n"
             "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
@@ -138,7 +138,12 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'j': o->stats_json = optarg; break;
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; break;
-        case 'h': usage(stdout); exit(0);
+        case 'h':
+            usage(stdout);
+            printf("calibrations:");
+            for (size_t i = 0; i < wc_tcu_calibration_count; ++i) { printf(" %s", wc_tcu_calibrations[i].name); }
+            printf("\n");
+            exit(0);
         default: usage(stderr); return -1;
         }
     }
@@ -184,20 +189,24 @@ int main(int argc, char **argv)
 {
     options_t opt;
     if (parse_options(argc, argv, &opt) != 0) { return 2; }
-    if (strcmp(opt.calibration, "table1") != 0) {
-        fprintf(stderr, "wc_tcu: --calibration: '%s' is not compiled in (available: table1); generate headers with"
-                        " `wetclutch lut` and rebuild\n", opt.calibration);
+    const wc_calibration_t *cal = NULL;
+    for (size_t i = 0; i < wc_tcu_calibration_count; ++i) {
+        if (strcmp(opt.calibration, wc_tcu_calibrations[i].name) == 0) { cal = wc_tcu_calibrations[i].calibration; }
+    }
+    if (cal == NULL) {
+        fprintf(stderr, "wc_tcu: --calibration: '%s' is not compiled in (wc_tcu --help lists them); generate its"
+                        " headers with `wetclutch lut` and add it to src/port/wc_tcu_calibrations.c\n", opt.calibration);
         return 2;
     }
     static wc_loop_t loop;  /* large (receive ring): static storage, not the stack */
     static step_times_t times;
     const wc_loop_config_t config = {opt.sensor_timeout, opt.request_timeout};
-    const wc_cal_error_t cal_error = wc_loop_init(&loop, &wc_table1_calibration, &config, (float)opt.theta_start_degC);
+    const wc_cal_error_t cal_error = wc_loop_init(&loop, cal, &config, (float)opt.theta_start_degC);
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
         return 2;
     }
-    if (opt.period_ns == 0) { opt.period_ns = (int64_t)((double)wc_table1_calibration.control_period_s * 1e9 + 0.5); }
+    if (opt.period_ns == 0) { opt.period_ns = (int64_t)((double)cal->control_period_s * 1e9 + 0.5); }
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);

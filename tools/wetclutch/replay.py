@@ -89,7 +89,7 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 # --------------------------------------------------------------------------- running on vcan
 
 def run_on_vcan(log, out_dir, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
-                jobs=None) -> None:
+                jobs=None, calibration: str = "table1") -> None:
     """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
     of jobs (default: the one log given). Progress goes to stderr. Raises on failure."""
     jobs = list(jobs) if jobs is not None else [(Path(log), Path(out_dir))]
@@ -104,7 +104,8 @@ def run_on_vcan(log, out_dir, frame_runs: int = 2, timer_runs: int = 1, tcu: Pat
         job_out.mkdir(parents=True, exist_ok=True)
         rw += ["--rwdir", str(job_out)]
         script.append(" ".join(["bash", _q(ROOT / "hil" / "replay_guest.sh"), _q(Path(job_log).resolve()), _q(job_out),
-                                "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", _q(tcu)]))
+                                "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", _q(tcu),
+                                "--calibration", _q(calibration)]))
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
