@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -79,6 +80,32 @@ def _cmd_replay(args) -> int:
     return 0
 
 
+def _cmd_identify(args) -> int:
+    from . import identify  # scipy.optimize and matplotlib only when needed
+    base = calibration.load(args.calibration)
+    settings = identify.Settings(jobs=max(1, args.jobs), thermistor_lag_s=args.thermistor_lag,
+                                 fit_heat_capacity=args.fit_heat_capacity, slip_min_rpm=args.slip_min,
+                                 simex=not args.no_simex)
+    command = " ".join(["wetclutch identify", args.step, args.data_dir, "--calibration", args.calibration,
+                        "--out", args.out] + (["--true", args.true] if args.true else [])
+                       + (["--fit-heat-capacity"] if args.fit_heat_capacity else [])
+                       + ([f"--thermistor-lag {args.thermistor_lag:g}"] if args.thermistor_lag is not None else [])
+                       + (["--no-simex"] if args.no_simex else []))
+    if args.true:
+        identify.read_true(Path(args.true))   # a bad --true fails before the work
+    result = identify.run(args.step, Path(args.data_dir), base, settings)
+    fig = identify.write_outputs(result, Path(args.calibration), Path(args.out), command,
+                                 Path(args.true) if args.true else None, plots=not args.no_plots)
+    print((Path(args.out) / "report.md").read_text().split("\n## Exclusions")[0])
+    print(f"wrote {args.out}/calibration.toml, report.md, figures.json, exclusions.csv"
+          + (f" and {len(fig['plots'])} plots" if fig["plots"] else ""))
+    missed = [k for k, v in fig["targets"].items() if not v]
+    if missed and args.true:
+        print("wetclutch identify: targets missed: " + ", ".join(missed), file=sys.stderr)
+        return 1
+    return 0
+
+
 def _cmd_bench(args) -> int:
     import time
     from . import bench  # the simulator only when needed
@@ -133,6 +160,20 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--no-reference-check", action="store_true",
                    help="skip comparing every TCU step with the double-precision reference")
     q.set_defaults(func=_cmd_replay)
+
+    q = sub.add_parser("identify", help="identify mu_f, k1/k2, viscosity, asperity density from bench data")
+    q.add_argument("step", choices=["mu", "thermal", "viscosity", "asperity", "all"])
+    q.add_argument("data_dir", help="bench data: index.csv + measurement CSVs (+ thermal/, viscosity.csv)")
+    q.add_argument("--calibration", "-c", default=DEFAULT_CAL, help="base calibration TOML")
+    q.add_argument("--out", default="out/identify", help="output directory (default out/identify)")
+    q.add_argument("--true", help="true-parameter TOML (simulated bench): report errors against it")
+    q.add_argument("--fit-heat-capacity", action="store_true", help="thermal: fit C with k1, k2")
+    q.add_argument("--thermistor-lag", type=float, help="thermistor time constant (s); default: identified")
+    q.add_argument("--slip-min", type=float, default=1.0, help="slip (rpm) below which the clutch counts as stuck")
+    q.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="worker processes for reading")
+    q.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    q.add_argument("--no-simex", action="store_true", help="mu: no errors-in-variables correction of mu2, v_s")
+    q.set_defaults(func=_cmd_identify)
 
     q = sub.add_parser("bench", help="simulate the test bench (DESIGN 7): measurement CSVs and CAN logs")
     q.add_argument("experiment", choices=("engagement", "table2", "thermal"),
