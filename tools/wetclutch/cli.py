@@ -65,7 +65,8 @@ def _cmd_replay(args) -> int:
     if not args.analyse_only:
         print(f"wetclutch replay: {len(jobs)} log(s) on vcan0 (the VM boot takes about a minute where the"
               " kernel has no CAN)", file=sys.stderr, flush=True)
-        replay.run_on_vcan(None, None, frame_runs=2, timer_runs=1, jobs=jobs)
+        replay.run_on_vcan(None, None, frame_runs=2, timer_runs=1, jobs=jobs,
+                           calibration=lut.c_identifier(Path(args.calibration).stem))
     missed = []
     for log, run_dir in jobs:
         print(f"wetclutch replay: analysing {log.name} (reference check of every step)", file=sys.stderr, flush=True)
@@ -155,7 +156,8 @@ def build_parser() -> argparse.ArgumentParser:
     q = sub.add_parser("replay", help="replay bench logs to wc_tcu on vcan0 and write the HIL report")
     q.add_argument("logs", nargs="+", help="candump -L bench logs (e.g. hil/logs/engagement_750rpm.log)")
     q.add_argument("--out", default="out/replay", help="report directory, one folder per log (default out/replay)")
-    q.add_argument("--calibration", "-c", default=DEFAULT_CAL, help="the calibration the TCU was built with")
+    q.add_argument("--calibration", "-c", default=DEFAULT_CAL,
+                   help="calibration TOML; wc_tcu runs the compiled-in calibration of the same name (its stem)")
     q.add_argument("--analyse-only", action="store_true", help="do not run: analyse the captures already in --out")
     q.add_argument("--no-reference-check", action="store_true",
                    help="skip comparing every TCU step with the double-precision reference")
