@@ -9,7 +9,10 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
 bash scripts/setup.sh
 
-.venv/bin/wetclutch lut tools/calibrations/table1.toml --out lut
+# The TCU runs the calibration identified from the bench's campaign (bench
+# data -> wetclutch identify -> calibration -> LUT headers -> firmware).
+cal=tools/calibrations/bench_identified.toml
+.venv/bin/wetclutch lut "$cal" --out lut
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release >/dev/null
-exec .venv/bin/wetclutch replay hil/logs/engagement_750rpm.log --out out/replay "$@"
+exec .venv/bin/wetclutch replay hil/logs/engagement_750rpm.log --calibration "$cal" --out out/replay "$@"

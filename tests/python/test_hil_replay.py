@@ -20,7 +20,8 @@ def replayed(root, tmp_path_factory):
         pytest.skip(f"{tcu} not built (scripts/test.sh builds it)")
     out = tmp_path_factory.mktemp("hil")
     run = subprocess.run([sys.executable, "-m", "wetclutch.cli", "replay",
-                          *[str(root / "hil" / "logs" / f"{name}.log") for name in LOGS], "--out", str(out)],
+                          *[str(root / "hil" / "logs" / f"{name}.log") for name in LOGS], "--out", str(out),
+                          "--calibration", str(root / "tools" / "calibrations" / "bench_identified.toml")],
                          cwd=root, capture_output=True, text=True,
                          env=dict(os.environ, PYTHONPATH=str(root / "tools")))
     print(run.stdout[-4000:], run.stderr[-4000:])

@@ -46,16 +46,18 @@ def test_non_monotone_axis_is_rejected():
 
 
 def _run_in_copy(root: Path, tmp: Path, args: list[str]) -> None:
-    (tmp / "tools" / "calibrations").mkdir(parents=True)
-    shutil.copy(root / "tools" / "calibrations" / "table1.toml", tmp / "tools" / "calibrations")
+    (tmp / "tools" / "calibrations").mkdir(parents=True, exist_ok=True)
+    for toml in (root / "tools" / "calibrations").glob("*.toml"):
+        shutil.copy(toml, tmp / "tools" / "calibrations")
     subprocess.run([sys.executable, "-m", "wetclutch.cli", *args], cwd=tmp, check=True, capture_output=True,
                    env={"PYTHONPATH": str(root / "tools")})
 
 
-def test_lut_regenerates_byte_identically(root, tmp_path):
-    _run_in_copy(root, tmp_path, ["lut", "tools/calibrations/table1.toml", "--out", "lut"])
-    for name in ("wc_table1_film.h", "wc_table1_calibration.h"):
-        assert (tmp_path / "lut" / name).read_bytes() == (root / "lut" / name).read_bytes(), name
+@pytest.mark.parametrize("name", ["table1", "bench_identified"])
+def test_lut_regenerates_byte_identically(root, tmp_path, name):
+    _run_in_copy(root, tmp_path, ["lut", f"tools/calibrations/{name}.toml", "--out", "lut"])
+    for header in (f"wc_{name}_film.h", f"wc_{name}_calibration.h"):
+        assert (tmp_path / "lut" / header).read_bytes() == (root / "lut" / header).read_bytes(), header
 
 
 def test_vectors_regenerate_byte_identically(root, tmp_path):
