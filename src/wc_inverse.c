@@ -35,9 +35,14 @@ wc_status_t wc_inverse(const wc_model_t *model, float slip_rad_s, float theta_de
         return status;
     }
     if (torque_request_Nm > wc_torque_point_magnitude(model, &point, model->force_max_N, &hbar_m)) {
-        status |= WC_STATUS_SATURATED;   /* beyond the capacity at the maximum current */
-        finish(model, model->force_max_N, &status, out);
-        return status;
+        /* Beyond the capacity at the maximum current: command exactly that
+         * current (recomputing it from F_max could land a float step above
+         * the range and raise a spurious clamp flag). */
+        const wc_calibration_t *cal = model->cal;
+        out->force_N = model->force_max_N;
+        out->current_mA = cal->vfs_current_max_mA;
+        out->pressure_Pa = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA;
+        return status | WC_STATUS_SATURATED;
     }
 
     /* T(F) is strictly increasing (eq. 8): keep T(lo) < request <= T(hi). */

@@ -1,4 +1,4 @@
-"""Command line: ``wetclutch {lut,reference,vectors}``."""
+"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay}``."""
 from __future__ import annotations
 
 import argparse
