@@ -81,7 +81,9 @@ static wc_loop_t loop;
 int main(void)
 {
     if (wc_clutch_init(&clutch, &wc_table1_calibration, wc_probe_in[1]) != WC_CAL_OK) { return 1; }
-    const wc_step_input_t in = { wc_probe_in[0], wc_probe_in[1], wc_probe_in[2], wc_probe_in[3], WC_MODE_TORQUE };
+    const wc_step_input_t in = { .slip_rad_s = wc_probe_in[0], .theta_oil_degC = wc_probe_in[1],
+                                 .theta_housing_degC = wc_probe_in[2], .torque_request_Nm = wc_probe_in[3],
+                                 .mode = WC_MODE_TORQUE };
     wc_step_output_t out;
     (void)wc_clutch_step(&clutch, &in, &out);
     wc_probe_out = out.current_mA;
