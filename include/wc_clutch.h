@@ -51,11 +51,19 @@ typedef struct {
     wc_status_t status;
 } wc_step_output_t;
 
+/* The last valid value of each checked input. */
+typedef struct {
+    float slip_rad_s;
+    float theta_oil_degC;
+    float theta_housing_degC;
+    float torque_request_Nm;
+} wc_held_inputs_t;
+
 typedef struct {
     wc_model_t model;
     float theta_degC;           /* observer state */
     float pressure_model_Pa;    /* VFS lag state */
-    wc_step_input_t held;       /* last valid value of each input */
+    wc_held_inputs_t held;
 } wc_clutch_t;
 
 /* Validate cal and start the observer at theta_start_degC (the oil

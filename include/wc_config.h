@@ -40,6 +40,16 @@
 #define WC_INVERSE_MAX_ITERATIONS 24u
 #endif
 
+/* Keep a helper out of its caller's stack frame (the stack figure is the sum
+ * along the deepest call chain). */
+#ifndef WC_NOINLINE
+#if defined(__GNUC__)
+#define WC_NOINLINE __attribute__((noinline))
+#else
+#define WC_NOINLINE
+#endif
+#endif
+
 /* Longest film table the library accepts (bounds the lookup's search). */
 #ifndef WC_FILM_MAX_NODES
 #define WC_FILM_MAX_NODES 1024u

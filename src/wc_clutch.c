@@ -19,12 +19,11 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
     clutch->held.theta_oil_degC = theta;
     clutch->held.theta_housing_degC = theta;
     clutch->held.torque_request_Nm = 0.0f;
-    clutch->held.mode = WC_MODE_OPEN;
     return WC_CAL_OK;
 }
 
 /* Replace each invalid input by its last valid value; remember the valid ones. */
-static wc_status_t accept_inputs(wc_step_input_t *held, const wc_step_input_t *in)
+static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *in)
 {
     wc_status_t status = WC_STATUS_OK;
     if (wc_slip_valid(in->slip_rad_s)) { held->slip_rad_s = in->slip_rad_s; }
@@ -42,7 +41,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 {
     const wc_model_t *model = &clutch->model;
     wc_status_t status = accept_inputs(&clutch->held, in);
-    const wc_step_input_t *u = &clutch->held;
+    const wc_held_inputs_t *u = &clutch->held;
 
     out->theta_degC = clutch->theta_degC;
     wc_inverse_t inv;

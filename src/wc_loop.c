@@ -78,7 +78,7 @@ static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded
     return true;
 }
 
-static void process(wc_loop_t *loop, const wc_can_frame_t *f)
+static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
 {
     if ((f->flags & (WC_CAN_FLAG_EXTENDED | WC_CAN_FLAG_REMOTE | WC_CAN_FLAG_ERROR)) != 0u) {
         reject(loop, WC_REJECT_FORMAT);
@@ -134,6 +134,37 @@ static uint16_t status_bits(wc_status_t status)
     return bits;
 }
 
+/* The two output frames of a step. Apart from wc_loop_step so that its
+ * locals are not on the stack while the model runs. */
+static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    const wc_step_output_t *o = &loop->last;
+    const wc_can_clutch_estimate_phys_t estimate = {
+        .estimated_clutch_temp_degC = o->theta_degC,
+        .model_torque_Nm = o->model.torque_Nm,
+        .mu_f = o->model.mu_f,
+        .film_thickness_um = o->model.hbar_m * 1.0e6f,
+    };
+    out[1].id = WC_CAN_CLUTCH_ESTIMATE_FRAME_ID;
+    out[1].dlc = WC_CAN_CLUTCH_ESTIMATE_LENGTH;
+    out[1].flags = 0u;
+    if (wc_can_encode_clutch_estimate(out[1].data, &estimate, sizeof out[1].data) == WC_CAN_SATURATED) {
+        bits |= WC_CAN_STATUS_SATURATED;
+    }
+    const wc_can_vfs_command_phys_t command = {
+        .vfs_current_mA = o->current_mA,
+        .pressure_command_kPa = o->pressure_command_Pa * 1.0e-3f,
+        .status = bits,
+        .alive_counter = loop->tx_alive,
+    };
+    loop->tx_alive = wc_e2e_counter_next(loop->tx_alive);
+    out[0].id = WC_CAN_VFS_COMMAND_FRAME_ID;
+    out[0].dlc = WC_CAN_VFS_COMMAND_LENGTH;
+    out[0].flags = 0u;
+    (void)wc_can_encode_vfs_command(out[0].data, &command, sizeof out[0].data);
+
+}
+
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
     for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (loop->rx_count > 0u); ++i) {
@@ -168,31 +199,7 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         loop->counters.safe_steps++;
     }
 
-    const wc_step_output_t *o = &loop->last;
-    const wc_can_clutch_estimate_phys_t estimate = {
-        .estimated_clutch_temp_degC = o->theta_degC,
-        .model_torque_Nm = o->model.torque_Nm,
-        .mu_f = o->model.mu_f,
-        .film_thickness_um = o->model.hbar_m * 1.0e6f,
-    };
-    out[1].id = WC_CAN_CLUTCH_ESTIMATE_FRAME_ID;
-    out[1].dlc = WC_CAN_CLUTCH_ESTIMATE_LENGTH;
-    out[1].flags = 0u;
-    if (wc_can_encode_clutch_estimate(out[1].data, &estimate, sizeof out[1].data) == WC_CAN_SATURATED) {
-        bits |= WC_CAN_STATUS_SATURATED;
-    }
-    const wc_can_vfs_command_phys_t command = {
-        .vfs_current_mA = o->current_mA,
-        .pressure_command_kPa = o->pressure_command_Pa * 1.0e-3f,
-        .status = bits,
-        .alive_counter = loop->tx_alive,
-    };
-    loop->tx_alive = wc_e2e_counter_next(loop->tx_alive);
-    out[0].id = WC_CAN_VFS_COMMAND_FRAME_ID;
-    out[0].dlc = WC_CAN_VFS_COMMAND_LENGTH;
-    out[0].flags = 0u;
-    (void)wc_can_encode_vfs_command(out[0].data, &command, sizeof out[0].data);
-
+    encode_outputs(loop, bits, out);
     loop->counters.steps++;
     loop->counters.frames_out += WC_LOOP_TX_FRAMES;
     return WC_LOOP_TX_FRAMES;
