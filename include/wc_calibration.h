@@ -68,7 +68,7 @@ typedef enum {
     WC_CAL_VFS_TIME_CONSTANT,
     WC_CAL_RETURN_SPRING_FORCE,
     WC_CAL_VFS_CURRENT_MIN,
-    WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum */
+    WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum, or a piston force above WC_FORCE_MAX_N */
     WC_CAL_CONTROL_PERIOD,
     WC_CAL_FILM_TABLE,          /* missing arrays, bad length, non-finite entry */
     WC_CAL_FILM_AXIS_NOT_MONOTONE

@@ -55,6 +55,11 @@ wc_cal_error_t wc_calibration_check(const wc_calibration_t *cal)
     if (!positive(cal->vfs_current_max_mA) || !(cal->vfs_current_max_mA > cal->vfs_current_min_mA)) {
         return WC_CAL_VFS_CURRENT_MAX;
     }
+    /* The inverse's iteration bound assumes the force range stays below
+     * WC_FORCE_MAX_N (2^WC_INVERSE_MAX_ITERATIONS halvings reach the tolerance). */
+    if (!(cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 <= WC_FORCE_MAX_N)) {
+        return WC_CAL_VFS_CURRENT_MAX;
+    }
     if (!positive(cal->control_period_s)) { return WC_CAL_CONTROL_PERIOD; }
     return check_film(&cal->film);
 }
