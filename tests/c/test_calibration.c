@@ -246,6 +246,20 @@ static void test_current_max_not_above_min(void **state)
     expect_code(&c.cal, WC_CAL_OK, "vfs_current_max_mA just above min", (double)c.cal.vfs_current_max_mA);
 }
 
+/* The inverse's iteration bound covers forces up to WC_FORCE_MAX_N: a piston
+ * force at the maximum current beyond it is rejected, naming the current. */
+static void test_force_at_max_current_within_bound(void **state)
+{
+    (void)state;
+    cal_copy_t c;
+    copy_table1(&c);
+    const float force_limit_mA = WC_FORCE_MAX_N / (c.cal.vfs_gain_Pa_per_mA * c.cal.piston_area_m2);
+    c.cal.vfs_current_max_mA = 1.01f * force_limit_mA;
+    expect_code(&c.cal, WC_CAL_VFS_CURRENT_MAX, "piston force above WC_FORCE_MAX_N", (double)c.cal.vfs_current_max_mA);
+    c.cal.vfs_current_max_mA = 0.99f * force_limit_mA;
+    expect_code(&c.cal, WC_CAL_OK, "piston force just below WC_FORCE_MAX_N", (double)c.cal.vfs_current_max_mA);
+}
+
 static void test_friction_pairs(void **state)
 {
     (void)state;
@@ -414,6 +428,7 @@ int main(void)
         cmocka_unit_test(test_boundary_values_are_accepted),
         cmocka_unit_test(test_inner_radius_not_below_outer),
         cmocka_unit_test(test_current_max_not_above_min),
+        cmocka_unit_test(test_force_at_max_current_within_bound),
         cmocka_unit_test(test_friction_pairs),
         cmocka_unit_test(test_first_failing_field_is_reported),
         cmocka_unit_test(test_film_table_missing_arrays_and_length),
