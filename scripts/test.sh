@@ -10,6 +10,10 @@ echo "== build: host-debug (address + undefined sanitizers)"
 cmake --preset host-debug >/dev/null
 cmake --build --preset host-debug
 
+echo "== build: host-release (wc_tcu for the vcan and HIL tests, wc_eval)"
+cmake --preset host-release >/dev/null
+cmake --build --preset host-release
+
 echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
 bash scripts/check_arm.sh
 
@@ -18,4 +22,5 @@ ctest --test-dir build/host-debug --output-on-failure
 
 echo "== Python tests (pytest)"
 export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
+export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
 exec .venv/bin/python -m pytest tests/python -ra

@@ -1,6 +1,7 @@
 """Shared fixtures for the Python tests: the repository root and the bundled calibration."""
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -22,3 +23,16 @@ def root() -> Path:
 @pytest.fixture(scope="session")
 def cal():
     return calibration.load(TABLE1)
+
+
+@pytest.fixture(scope="session")
+def tcu() -> Path:
+    """The TCU program (host-release build). Missing: a skip for a developer
+    running pytest alone, a failure in CI, where scripts/test.sh builds it."""
+    path = ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
+    if not path.is_file():
+        message = f"{path} not built (cmake --preset host-release && cmake --build --preset host-release)"
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip(message)
+    return path

@@ -14,10 +14,7 @@ LOGS = ("engagement_750rpm", "engagement_500rpm", "engagement_250rpm")
 
 
 @pytest.fixture(scope="module")
-def replayed(root, tmp_path_factory):
-    tcu = root / "build" / "host-release" / "src" / "port" / "wc_tcu"
-    if not tcu.is_file():
-        pytest.skip(f"{tcu} not built (scripts/test.sh builds it)")
+def replayed(root, tmp_path_factory, tcu):
     out = tmp_path_factory.mktemp("hil")
     run = subprocess.run([sys.executable, "-m", "wetclutch.cli", "replay",
                           *[str(root / "hil" / "logs" / f"{name}.log") for name in LOGS], "--out", str(out),

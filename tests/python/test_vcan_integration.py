@@ -50,10 +50,7 @@ def _input_log(path: Path) -> list:
 
 
 @pytest.fixture(scope="module")
-def replayed(tmp_path_factory, root):
-    tcu = root / "build" / "host-release" / "src" / "port" / "wc_tcu"
-    if not tcu.is_file():
-        pytest.skip(f"{tcu} not built (scripts/test.sh builds it)")
+def replayed(tmp_path_factory, root, tcu):
     work = tmp_path_factory.mktemp("vcan")
     log = work / "input.log"
     _input_log(log)
