@@ -228,7 +228,8 @@ def summary(m: dict, name: str) -> str:
         " | — | reported |",
         "",
         f"Rejected input frames by reason: {m['frames_rejected']}.",
-        f"Contact at {m['t_contact_s']:.3f} s, lock at {m['t_lock_s']} s; steady state = from contact + "
+        f"Contact at {m['t_contact_s']:.3f} s, lock at "
+        f"{'none' if m['t_lock_s'] is None else format(m['t_lock_s'], '.3f') + ' s'}; steady state = from contact + "
         f"{FILM_TRANSIENT_S} s while slipping (> {SLIPPING_RPM} rpm): {m['steady_samples']} steps.",
     ]
     if "tcu_vs_reference_max_abs" in m:
