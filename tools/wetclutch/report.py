@@ -148,9 +148,13 @@ def plots(cal: Calibration, s: Series, m: dict, out_dir: Path) -> list[str]:
     a.plot(s.t_s, s.torque_model_Nm, label="model (TCU ClutchEstimate)", lw=1)
     a.axvline(m["t_contact_s"], color="gray", ls=":", lw=0.8)
     a.axvline(m["t_contact_s"] + FILM_TRANSIENT_S, color="gray", ls="--", lw=0.8)
+    if m["t_lock_s"] is not None:  # the model has no static friction: at slip ~ 0 its sign follows the slip noise
+        a.axvspan(m["t_lock_s"], float(s.t_s[-1]), color="0.9", lw=0,
+                  label="locked: model undefined at zero slip (paper 3.5)")
+        b.axvspan(m["t_lock_s"], float(s.t_s[-1]), color="0.9", lw=0)
     a.set_ylabel("torque [Nm]")
     a.set_title(f"Engagement at {m['initial_slip_rpm']:.0f} rpm (cf. paper Fig. 15)")
-    a.legend()
+    a.legend(fontsize=8, loc="lower left")
     b.plot(s.t_s, s.torque_model_Nm - s.torque_meas_Nm, lw=0.8, color="C3")
     b.set_ylabel("error [Nm]")
     b.set_xlabel("time [s]")
