@@ -23,9 +23,4 @@ static inline bool wc_theta_valid(float theta_degC)
     return wc_in_range(theta_degC, WC_THETA_MIN_degC, WC_THETA_MAX_degC);
 }
 
-static inline float wc_clampf(float x, float lo, float hi)
-{
-    return (x < lo) ? lo : ((x > hi) ? hi : x);
-}
-
 #endif /* WC_INTERNAL_H */

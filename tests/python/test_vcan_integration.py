@@ -54,7 +54,7 @@ def replayed(tmp_path_factory, root, tcu):
     work = tmp_path_factory.mktemp("vcan")
     log = work / "input.log"
     _input_log(log)
-    replay.run_on_vcan(log, work / "out", frame_runs=2, timer_runs=1, tcu=tcu)
+    replay.run_on_vcan([(log, work / "out")], frame_runs=2, timer_runs=1, tcu=tcu)
     return log, work / "out"
 
 

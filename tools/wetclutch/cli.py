@@ -52,7 +52,7 @@ def _cmd_vectors(args) -> int:
 
 
 def _cmd_replay(args) -> int:
-    from . import canlog, replay, report  # matplotlib and the CAN stack only when needed
+    from . import replay, report  # matplotlib and the CAN stack only when needed
     cal = calibration.load(args.calibration)
     out_root = Path(args.out)
     jobs = []
@@ -65,7 +65,7 @@ def _cmd_replay(args) -> int:
     if not args.analyse_only:
         print(f"wetclutch replay: {len(jobs)} log(s) on vcan0 (the VM boot takes about a minute where the"
               " kernel has no CAN)", file=sys.stderr, flush=True)
-        replay.run_on_vcan(None, None, frame_runs=2, timer_runs=1, jobs=jobs,
+        replay.run_on_vcan(jobs, frame_runs=2, timer_runs=1,
                            calibration=lut.c_identifier(Path(args.calibration).stem))
     missed = []
     for log, run_dir in jobs:

@@ -56,7 +56,6 @@ import math
 import os
 import re
 import time
-import tomllib
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1193,26 +1192,11 @@ def _render_full(cal: Calibration, sources: dict[str, str], header: str) -> str:
 
 
 def read_true(path: Path) -> dict[str, float]:
-    """True parameters: a calibration-style TOML (extra bench-only entries are ignored)."""
+    """True parameters: a calibration file (the bench's, e.g. bench_true.toml)."""
     try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except OSError as e:
-        raise IdentifyError(f"{path}: cannot read: {e.strerror}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise IdentifyError(f"{path}: not valid TOML: {e}") from None
-    out = {}
-
-    def visit(table):
-        for k, v in table.items():
-            if isinstance(v, dict) and "value" in v and isinstance(v["value"], (int, float)):
-                out[k] = float(v["value"])
-            elif isinstance(v, dict):
-                visit(v)
-            elif isinstance(v, (int, float)) and not isinstance(v, bool):
-                out.setdefault(k, float(v))
-    visit(doc)
-    return out
+        return dict(load_calibration(path).values)
+    except CalibrationError as e:
+        raise IdentifyError(str(e)) from None
 
 
 # ---------------------------------------------------------------------------
@@ -1562,7 +1546,7 @@ def _markdown(res: Result, fig: dict, truth: dict | None) -> str:
               " adds theta_m' and theta_m'' terms, and tau is estimated with k1 and k2 (nonlinear least squares"
               " started from the unconstrained linear regression)"
               + (" — here fixed by --thermistor-lag." if "fixed" in t["thermistor_lag_source"] else "."), "",
-              f"| | value |", "|---|---|",
+              "| | value |", "|---|---|",
               f"| thermistor lag tau | {t['thermistor_lag_s']:.4g} s (± {t['thermistor_lag_ci95']:.2g}), {t['thermistor_lag_source']} |",
               f"| heat capacity C | {t['heat_capacity_J_K']:.5g} J/K, {t['heat_capacity_source']} |",
               f"| eq. 19 fit | R² {t['r2_eq19']:.6f}, RMSE {t['rmse_eq19_W']:.4g} W |",

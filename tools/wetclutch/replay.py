@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import subprocess
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -88,11 +88,10 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 
 # --------------------------------------------------------------------------- running on vcan
 
-def run_on_vcan(log, out_dir, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
-                jobs=None, calibration: str = "table1") -> None:
+def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
+                calibration: str = "table1") -> None:
     """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
-    of jobs (default: the one log given). Progress goes to stderr. Raises on failure."""
-    jobs = list(jobs) if jobs is not None else [(Path(log), Path(out_dir))]
+    of jobs. Progress goes to stderr. Raises on failure."""
     tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
     if not tcu.is_file():
         raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
@@ -103,20 +102,15 @@ def run_on_vcan(log, out_dir, frame_runs: int = 2, timer_runs: int = 1, tcu: Pat
         job_out = Path(job_out).resolve()
         job_out.mkdir(parents=True, exist_ok=True)
         rw += ["--rwdir", str(job_out)]
-        script.append(" ".join(["bash", _q(ROOT / "hil" / "replay_guest.sh"), _q(Path(job_log).resolve()), _q(job_out),
-                                "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs), "--tcu", _q(tcu),
-                                "--calibration", _q(calibration)]))
+        script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
+                                  str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
+                                  "--tcu", str(tcu), "--calibration", calibration]))
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
     if result.returncode != 0:
         raise RuntimeError(f"replay on vcan failed (exit {result.returncode}); see the messages above and"
                            f" the wc_tcu logs (*.txt) in {', '.join(str(o) for _, o in jobs)}")
-
-
-def _q(path) -> str:
-    import shlex
-    return shlex.quote(str(path))
 
 
 # --------------------------------------------------------------------------- reference of the loop
@@ -266,7 +260,3 @@ def load_stats(path: Path) -> dict:
         return json.loads(Path(path).read_text())
     except (OSError, json.JSONDecodeError) as e:
         raise canlog.LogError(f"{path}: wc_tcu statistics unreadable: {e}") from None
-
-
-def main_progress(text: str) -> None:
-    print(text, file=sys.stderr, flush=True)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import model, reference
+from . import reference
 from .calibration import Calibration
 from .lut import banner
 
