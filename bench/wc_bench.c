@@ -22,7 +22,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "wetclutch.h"
+#include "wetclutch/wetclutch.h"
 #include "wc_table1_calibration.h"
 
 #ifdef WC_HAVE_CALLGRIND_H
@@ -95,6 +95,7 @@ static wc_step_input_t point_input(const bench_point_t *p)
         .theta_oil_degC = p->theta_degC,
         .theta_housing_degC = p->theta_degC,
         .torque_request_Nm = p->request_Nm,
+        .mode = WC_MODE_TORQUE,
     };
     return in;
 }

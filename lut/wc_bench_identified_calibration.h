@@ -3,7 +3,7 @@
 #ifndef WC_LUT_BENCH_IDENTIFIED_CALIBRATION_H
 #define WC_LUT_BENCH_IDENTIFIED_CALIBRATION_H
 
-#include "wc_calibration.h"
+#include <wetclutch/wc_calibration.h>
 #include "wc_bench_identified_film.h"
 
 static const wc_calibration_t wc_bench_identified_calibration = {

@@ -3,7 +3,7 @@
 #ifndef WC_LUT_TABLE1_CALIBRATION_H
 #define WC_LUT_TABLE1_CALIBRATION_H
 
-#include "wc_calibration.h"
+#include <wetclutch/wc_calibration.h>
 #include "wc_table1_film.h"
 
 static const wc_calibration_t wc_table1_calibration = {

@@ -26,8 +26,8 @@ cd "$repo"
 preset=cortex-m4f
 build="$repo/build/$preset"
 work="$build/check_arm"
-lib="$build/libwetclutch.a"
-can_lib="$build/libwetclutch_can.a"
+lib="$build/src/model/libwetclutch.a"
+can_lib="$build/src/can/libwetclutch_can.a"
 prefix=arm-none-eabi-
 
 for tool in cmake ninja python3 ${prefix}gcc ${prefix}nm ${prefix}size ${prefix}objdump; do
@@ -56,7 +56,7 @@ const wc_calibration_t *const wc_arm_calibration = &wc_table1_calibration;
 EOF
 cat >"$work/wc_arm_probe.c" <<'EOF'
 /* Compile-time figures, read back from the object's symbol sizes (nm -S). */
-#include "wetclutch.h"
+#include "wetclutch/wetclutch.h"
 
 extern const unsigned char wc_probe_sizeof_clutch[sizeof(wc_clutch_t)];
 const unsigned char wc_probe_sizeof_clutch[sizeof(wc_clutch_t)] = {0u};
@@ -68,8 +68,8 @@ EOF
 cat >"$work/wc_arm_main.c" <<'EOF'
 /* Smallest firmware that uses the library: init one clutch from table1, step it,
  * and run the CAN frame loop once. */
-#include "wetclutch.h"
-#include "wc_loop.h"
+#include "wetclutch/wetclutch.h"
+#include "wetclutch_can/wc_loop.h"
 #include "wc_table1_calibration.h"
 
 volatile float wc_probe_in[4];
@@ -112,12 +112,12 @@ int main(void)
 }
 EOF
 
-# Compile each probe exactly as CMake compiled src/wc_clutch.c (same -mcpu,
+# Compile each probe exactly as CMake compiled src/model/wc_clutch.c (same -mcpu,
 # -O, warnings, -Werror, include paths).
 mapfile -t cflags < <(python3 - "$build/compile_commands.json" <<'EOF'
 import json, shlex, sys
 for entry in json.load(open(sys.argv[1])):
-    if entry["file"].endswith("src/wc_clutch.c"):
+    if entry["file"].endswith("src/model/wc_clutch.c"):
         args = shlex.split(entry["command"])[1:]
         out, skip = [], False
         for a in args:
@@ -128,10 +128,9 @@ for entry in json.load(open(sys.argv[1])):
         print("\n".join(out))
         break
 else:
-    sys.exit("compile_commands.json has no src/wc_clutch.c")
+    sys.exit("compile_commands.json has no src/model/wc_clutch.c")
 EOF
 )
-cflags+=("-I$repo/src/can")  # the CAN layer's headers, for the loop in the probe firmware
 cpu_flags=(-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16)
 for tu in wc_arm_calibration wc_arm_probe wc_arm_main wc_arm_baseline; do
   if ! (cd "$work" && ${prefix}gcc "${cflags[@]}" -c "$tu.c" -o "$tu.o") >"$log" 2>&1; then
@@ -203,7 +202,7 @@ max_iterations=$(symsize wc_probe_inverse_max_iterations)
 # Iterations the bisection needs for table1: the bracket [0, F_max] halves
 # until it is at most WC_INVERSE_FORCE_TOLERANCE_N wide.
 lut_value() { sed -n "s/^ *\.$1 = \([-0-9.eE+]*\)f.*/\1/p" lut/wc_table1_calibration.h; }
-tolerance=$(sed -n 's/^#define WC_INVERSE_FORCE_TOLERANCE_N \([0-9.eE+-]*\)f.*/\1/p' include/wc_config.h)
+tolerance=$(sed -n 's/^#define WC_INVERSE_FORCE_TOLERANCE_N \([0-9.eE+-]*\)f.*/\1/p' include/wetclutch/wc_config.h)
 read -r force_max needed < <(awk -v k="$(lut_value vfs_gain_Pa_per_mA)" -v i="$(lut_value vfs_current_max_mA)" \
   -v a="$(lut_value piston_area_m2)" -v fs="$(lut_value return_spring_force_N)" -v tol="$tolerance" 'BEGIN {
     f = k * i * a - fs; n = 0; w = f; while (w > tol) { w /= 2; n++ }
@@ -211,7 +210,7 @@ read -r force_max needed < <(awk -v k="$(lut_value vfs_gain_Pa_per_mA)" -v i="$(
 
 # Stack: own frames (.su) summed along the call graph (.ci); functions outside
 # the library (expf and what it calls) from their prologues in the linked image.
-stack_report=$(python3 - "$build/CMakeFiles/wetclutch.dir:$build/CMakeFiles/wetclutch_can.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
+stack_report=$(python3 - "$build/src/model/CMakeFiles/wetclutch.dir:$build/src/can/CMakeFiles/wetclutch_can.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
 import glob, os, re, subprocess, sys
 objdir, elf, objdump, incdir = sys.argv[1:5]
 
@@ -289,7 +288,9 @@ def worst(title, stack=()):
     return result
 
 public = set()
-for h in glob.glob(os.path.join(incdir, "*.h")):
+for h in glob.glob(os.path.join(incdir, "*", "*.h")):
+    if os.path.basename(h) == "wc_can.h":
+        continue  # cantools' raw pack/unpack: leaf functions, listed as internal
     public |= set(re.findall(r"\b(wc_[A-Za-z0-9_]+)\s*\(", open(h).read()))
 rows = []
 for title in nodes:

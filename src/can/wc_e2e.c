@@ -1,5 +1,5 @@
 /* E2E protection: CRC-8 SAE J1850 and alive counter. See wc_e2e.h. */
-#include "wc_e2e.h"
+#include "wetclutch_can/wc_e2e.h"
 
 /* One byte into the (non-reflected) CRC-8 register, bitwise: 8 steps. */
 static uint8_t crc8_j1850_update(uint8_t crc, uint8_t byte)

@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "wetclutch.h"
+#include "wetclutch/wetclutch.h"
 #include "wc_table1_calibration.h"
 
 #define LINE_MAX_CHARS 4096u   /* longest input line accepted, newline included */

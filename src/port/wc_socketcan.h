@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "wc_can_frame.h"
+#include "wetclutch_can/wc_can_frame.h"
 
 typedef struct {
     int fd;

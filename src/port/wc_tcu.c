@@ -17,7 +17,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "wc_loop.h"
+#include "wetclutch_can/wc_loop.h"
 #include "wc_socketcan.h"
 #include "wc_tcu_calibrations.h"
 

@@ -6,7 +6,7 @@
 
 #include <stddef.h>
 
-#include "wc_calibration.h"
+#include "wetclutch/wc_calibration.h"
 
 typedef struct {
     const char *name;

@@ -11,8 +11,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "wc_can_scaling.h"
-#include "wc_e2e.h"
+#include "wetclutch_can/wc_can_signals.h"
+#include "wetclutch_can/wc_e2e.h"
 
 #define FRAME_BYTES 8u
 

@@ -9,7 +9,7 @@
 
 #define STEPS 1500
 
-/* Torque control (the zero value of any other field, e.g. the mode). */
+/* Torque control (zero in every other field). */
 static wc_step_input_t input(float slip_rad_s, float theta_oil_degC, float theta_housing_degC, float torque_Nm)
 {
     wc_step_input_t in;
@@ -18,6 +18,7 @@ static wc_step_input_t input(float slip_rad_s, float theta_oil_degC, float theta
     in.theta_oil_degC = theta_oil_degC;
     in.theta_housing_degC = theta_housing_degC;
     in.torque_request_Nm = torque_Nm;
+    in.mode = WC_MODE_TORQUE;
     return in;
 }
 

@@ -30,7 +30,7 @@
 #include "wc_test_support.h"
 
 #include "wc_golden_vectors.h"
-#include "wc_loop.h"
+#include "wetclutch_can/wc_loop.h"
 #include "wc_table1_calibration.h"
 
 #define THETA_START_degC 40.0f

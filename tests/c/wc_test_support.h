@@ -14,7 +14,7 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "wetclutch.h"
+#include "wetclutch/wetclutch.h"
 
 /* rpm -> rad/s in double; the tests round the product to float once. */
 #define WC_TEST_RAD_S_PER_RPM (3.14159265358979323846 / 30.0)

@@ -2,7 +2,7 @@
  * from the generated table1 calibration, step it once, check the answer. */
 #include <stdio.h>
 
-#include "wetclutch.h"
+#include <wetclutch/wetclutch.h>
 #include "wc_table1_calibration.h"
 
 int main(void)
@@ -18,6 +18,7 @@ int main(void)
         .theta_oil_degC = 80.0f,
         .theta_housing_degC = 70.0f,
         .torque_request_Nm = 100.0f,
+        .mode = WC_MODE_TORQUE,
     };
     wc_step_output_t out;
     const wc_status_t status = wc_clutch_step(&clutch, &in, &out);

@@ -150,7 +150,7 @@ def calibration_header(cal: Calibration, ident: str, command: str) -> str:
         banner(command)
         + f"/* Calibration '{ident}' from {Path(cal.path).name}. Include in one translation unit. */\n"
         f"#ifndef WC_LUT_{up}_CALIBRATION_H\n#define WC_LUT_{up}_CALIBRATION_H\n\n"
-        "#include \"wc_calibration.h\"\n"
+        "#include <wetclutch/wc_calibration.h>\n"
         f"#include \"wc_{ident}_film.h\"\n\n"
         f"static const wc_calibration_t wc_{ident}_calibration = {{\n" + "\n".join(lines) + "\n};\n\n"
         f"#endif /* WC_LUT_{up}_CALIBRATION_H */\n"

@@ -32,7 +32,7 @@
 
 #include <string.h>
 
-#include "wc_can.h"
+#include "wetclutch_can/wc_can.h"
 
 static inline uint8_t pack_left_shift_u8(
     uint8_t value,

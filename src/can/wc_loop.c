@@ -1,10 +1,10 @@
-#include "wc_loop.h"
+#include "wetclutch_can/wc_loop.h"
 
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
 
-#include "wetclutch.h"
+#include "wetclutch/wetclutch.h"
 
 static void input_reset(wc_loop_input_t *in)
 {
@@ -115,22 +115,36 @@ static bool update_freshness(wc_loop_input_t *in, uint32_t timeout_periods, uint
     return stale;
 }
 
+/* One numbering for the mode: the C enum has the DBC's values. */
+WC_STATIC_ASSERT(WC_MODE_OPEN == WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE, mode_open_is_dbc_open);
+WC_STATIC_ASSERT(WC_MODE_TORQUE == WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE, mode_torque_is_dbc_torque);
+WC_STATIC_ASSERT(WC_MODE_LOCKED == WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE, mode_locked_is_dbc_locked);
+
+/* A decoded Mode passed the DBC range check; anything else releases. */
 static wc_clutch_mode_t mode_of(uint8_t can_mode)
 {
-    switch (can_mode) {
-    case WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE: return WC_MODE_TORQUE;
-    case WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE: return WC_MODE_LOCKED;
-    default: return WC_MODE_OPEN;
-    }
+    return (can_mode <= (uint8_t)WC_MODE_LOCKED) ? (wc_clutch_mode_t)can_mode : WC_MODE_OPEN;
 }
+
+/* Model status bit -> VfsCommand status bit. */
+typedef struct {
+    wc_status_t model;
+    uint16_t can;
+} wc_status_map_t;
+
+static const wc_status_map_t status_map[] = {
+    { WC_STATUS_SATURATED, WC_CAN_STATUS_SATURATED },
+    { WC_STATUS_CURRENT_CLAMPED, WC_CAN_STATUS_CURRENT_CLAMPED },
+    { WC_STATUS_BELOW_DRAG, WC_CAN_STATUS_BELOW_DRAG },
+    { WC_STATUS_INPUT_INVALID, WC_CAN_STATUS_IMPLAUSIBLE_INPUT },
+};
 
 static uint16_t status_bits(wc_status_t status)
 {
     uint16_t bits = 0u;
-    if ((status & WC_STATUS_SATURATED) != 0u) { bits |= WC_CAN_STATUS_SATURATED; }
-    if ((status & WC_STATUS_CURRENT_CLAMPED) != 0u) { bits |= WC_CAN_STATUS_CURRENT_CLAMPED; }
-    if ((status & WC_STATUS_BELOW_DRAG) != 0u) { bits |= WC_CAN_STATUS_BELOW_DRAG; }
-    if ((status & WC_STATUS_INPUT_INVALID) != 0u) { bits |= WC_CAN_STATUS_IMPLAUSIBLE_INPUT; }
+    for (size_t i = 0u; i < (sizeof status_map / sizeof status_map[0]); ++i) {
+        if ((status & status_map[i].model) != 0u) { bits = (uint16_t)(bits | status_map[i].can); }
+    }
     return bits;
 }
 

@@ -1,4 +1,4 @@
-#include "wc_hydraulics.h"
+#include "wetclutch/wc_hydraulics.h"
 
 #include <math.h>
 

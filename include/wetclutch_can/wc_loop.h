@@ -34,8 +34,8 @@
 #include <stdint.h>
 
 #include "wc_can_frame.h"
-#include "wc_can_scaling.h"
-#include "wc_clutch.h"
+#include "wc_can_signals.h"
+#include <wetclutch/wc_clutch.h>
 #include "wc_e2e.h"
 
 #define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */

@@ -1,4 +1,4 @@
-#include "wc_friction.h"
+#include "wetclutch/wc_friction.h"
 
 #include <math.h>
 

@@ -1,4 +1,4 @@
-#include "wc_thermal.h"
+#include "wetclutch/wc_thermal.h"
 
 #include <math.h>
 

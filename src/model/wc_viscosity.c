@@ -1,4 +1,4 @@
-#include "wc_viscosity.h"
+#include "wetclutch/wc_viscosity.h"
 
 #include <math.h>
 

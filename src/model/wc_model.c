@@ -1,4 +1,4 @@
-#include "wc_model.h"
+#include "wetclutch/wc_model.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -4,7 +4,7 @@
 #ifndef WC_TORQUE_POINT_H
 #define WC_TORQUE_POINT_H
 
-#include "wc_model.h"
+#include "wetclutch/wc_model.h"
 
 typedef struct {
     float coulomb_Nm_per_N;  /* R_eff N_c mu_f(v, theta), eq. 6 */

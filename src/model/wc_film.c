@@ -1,6 +1,6 @@
-#include "wc_film.h"
+#include "wetclutch/wc_film.h"
 
-#include "wc_config.h"
+#include "wetclutch/wc_config.h"
 
 float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
 {

@@ -1,13 +1,13 @@
-#include "wc_torque.h"
+#include "wetclutch/wc_torque.h"
 
 #include <math.h>
 #include <stddef.h>
 
-#include "wc_film.h"
-#include "wc_friction.h"
+#include "wetclutch/wc_film.h"
+#include "wetclutch/wc_friction.h"
 #include "wc_internal.h"
 #include "wc_torque_point.h"
-#include "wc_viscosity.h"
+#include "wetclutch/wc_viscosity.h"
 
 void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point)
 {

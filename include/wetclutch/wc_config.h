@@ -7,10 +7,25 @@
 #include WC_CONFIG_HEADER
 #endif
 
-/* Assertion hook for internal invariants (never for bad input, which is
- * reported through status codes). Route it to the integrator's fault handler. */
+/* The integrator's hook for violated API contracts: a NULL pointer, an
+ * instance that was never initialised or whose init failed. Never used for bad
+ * input data, which is reported through status bits. Default: off (the
+ * condition is not evaluated). Route it to the fault handler of the firmware,
+ * e.g. in the WC_CONFIG_HEADER:
+ *     #define WC_ASSERT(cond) do { if (!(cond)) { tcu_fault(__FILE__, __LINE__); } } while (0)
+ * The unit tests route it to cmocka's mock_assert (tests/c/test_contracts.c). */
 #ifndef WC_ASSERT
 #define WC_ASSERT(cond) ((void)0)
+#endif
+
+/* Compile-time check, C99-compatible (C11's _Static_assert where available).
+ * name must be a valid identifier, unique in its translation unit. */
+#ifndef WC_STATIC_ASSERT
+#if defined(__STDC_VERSION__) && (__STDC_VERSION__ >= 201112L)
+#define WC_STATIC_ASSERT(cond, name) _Static_assert((cond), #name)
+#else
+#define WC_STATIC_ASSERT(cond, name) typedef char wc_static_assert_##name[(cond) ? 1 : -1]
+#endif
 #endif
 
 /* Plausible input ranges; a value outside is rejected as implausible. */

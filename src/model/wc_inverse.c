@@ -1,8 +1,8 @@
-#include "wc_inverse.h"
+#include "wetclutch/wc_inverse.h"
 
 #include <math.h>
 
-#include "wc_hydraulics.h"
+#include "wetclutch/wc_hydraulics.h"
 #include "wc_internal.h"
 #include "wc_torque_point.h"
 

@@ -1,10 +1,10 @@
-#include "wc_calibration.h"
+#include "wetclutch/wc_calibration.h"
 
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "wc_config.h"
+#include "wetclutch/wc_config.h"
 
 static bool positive(float x) { return isfinite(x) && (x > 0.0f); }
 static bool nonnegative(float x) { return isfinite(x) && (x >= 0.0f); }

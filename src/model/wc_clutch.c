@@ -1,11 +1,11 @@
-#include "wc_clutch.h"
+#include "wetclutch/wc_clutch.h"
 
 #include <math.h>
 #include <stddef.h>
 
-#include "wc_hydraulics.h"
+#include "wetclutch/wc_hydraulics.h"
 #include "wc_internal.h"
-#include "wc_thermal.h"
+#include "wetclutch/wc_thermal.h"
 
 wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, float theta_start_degC)
 {

@@ -12,11 +12,12 @@
 #include "wc_status.h"
 #include "wc_torque.h"
 
-/* What the solenoid is asked to do. Torque control is 0, the default of a
- * zero-initialized input. */
+/* What the solenoid is asked to do. The values are those of the DBC signal
+ * TorqueRequest.Mode (hil/wetclutch.dbc; the CAN layer static_asserts it), so
+ * a zero-initialized input asks for the released clutch. */
 typedef enum {
-    WC_MODE_TORQUE = 0,  /* invert the model to deliver torque_request_Nm */
-    WC_MODE_OPEN = 1,    /* minimum current: clutch released (also the safe state) */
+    WC_MODE_OPEN = 0,    /* minimum current: clutch released (also the safe state) */
+    WC_MODE_TORQUE = 1,  /* invert the model to deliver torque_request_Nm */
     WC_MODE_LOCKED = 2   /* maximum current: clutch locked */
 } wc_clutch_mode_t;
 

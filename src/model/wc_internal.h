@@ -5,7 +5,7 @@
 #include <math.h>
 #include <stdbool.h>
 
-#include "wc_config.h"
+#include "wetclutch/wc_config.h"
 
 static inline bool wc_in_range(float x, float lo, float hi)
 {
