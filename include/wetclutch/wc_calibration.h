@@ -71,7 +71,8 @@ typedef enum {
     WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum, or a piston force above WC_FORCE_MAX_N */
     WC_CAL_CONTROL_PERIOD,
     WC_CAL_FILM_TABLE,          /* missing arrays, bad length, non-finite entry */
-    WC_CAL_FILM_AXIS_NOT_MONOTONE
+    WC_CAL_FILM_AXIS_NOT_MONOTONE,
+    WC_CAL_ERRORS               /* number of codes, not an error */
 } wc_cal_error_t;
 
 /* Check every field: finite, positive where the physics needs it, film axis

@@ -65,6 +65,18 @@
 #endif
 #endif
 
+/* Orders memory accesses around the receive ring's index updates
+ * (wc_loop_receive in an ISR, wc_loop_step in a task; include/wetclutch_can/
+ * wc_loop.h). A compiler barrier is enough on a single-core MCU; a multi-core
+ * integration overrides it with a hardware barrier (e.g. __DMB()). */
+#ifndef WC_MEMORY_BARRIER
+#if defined(__GNUC__)
+#define WC_MEMORY_BARRIER() __asm__ volatile("" ::: "memory")
+#else
+#define WC_MEMORY_BARRIER() ((void)0)
+#endif
+#endif
+
 /* Longest film table the library accepts (bounds the lookup's search). */
 #ifndef WC_FILM_MAX_NODES
 #define WC_FILM_MAX_NODES 1024u

@@ -1,7 +1,23 @@
 /* The CAN frame loop of one clutch: portable (no OS calls), fixed-size
  * receive ring, E2E checks, input freshness, one model step per period and
  * the two output frames. The frames and their scaling are those of
- * hil/wetclutch.dbc (codec in src/can/).
+ * hil/wetclutch.dbc (generated codec: wc_can.h, wc_can_signals.h).
+ *
+ * Who may call what, from where (one wc_loop_t per clutch, no shared state
+ * between instances, no locks inside):
+ *  - wc_loop_receive may run in the CAN receive interrupt while the task runs
+ *    wc_loop_step: the receive ring is single-producer/single-consumer, each
+ *    index has one writer (rx_tail: wc_loop_receive, rx_head: wc_loop_step),
+ *    and the producer touches nothing else but counters.frames_in and
+ *    counters.rejected[WC_REJECT_OVERFLOW]. At most one producer context per
+ *    instance (two receive ISRs of different priority need a critical
+ *    section around the call). WC_MEMORY_BARRIER orders the index updates
+ *    (wc_config.h: a compiler barrier, enough on a single core).
+ *  - wc_loop_step, wc_loop_iterate, wc_loop_deadline_missed and reading
+ *    counters/last run in one task context (the periodic task); never
+ *    concurrently with each other.
+ *  - wc_loop_init runs before the interrupt that calls wc_loop_receive is
+ *    enabled.
  *
  * Safe-state policy (also in README.md):
  *  - A received frame is used only if its length, CRC and alive counter are
@@ -82,8 +98,8 @@ typedef struct {
     wc_clutch_t clutch;
     wc_loop_config_t config;
     wc_can_frame_t rx[WC_LOOP_RX_CAPACITY];
-    uint32_t rx_head;
-    uint32_t rx_count;
+    volatile uint32_t rx_head;      /* frames taken by wc_loop_step (written only there) */
+    volatile uint32_t rx_tail;      /* frames queued by wc_loop_receive (written only there) */
     wc_loop_input_t sensors_in;
     wc_loop_input_t request_in;
     wc_loop_input_t bench_in;
@@ -111,6 +127,20 @@ void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed);
  * model, and write the output frames (VfsCommand, ClutchEstimate) to out.
  * Returns the number of frames written (WC_LOOP_TX_FRAMES). */
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
+
+/* When a port's main loop steps the model. */
+typedef enum {
+    WC_LOOP_CLOCK_TIMER = 0,  /* a fixed period: the port passes tick = true at each deadline */
+    WC_LOOP_CLOCK_FRAME = 1   /* one step per received ClutchSensors data frame (deterministic replay) */
+} wc_loop_clock_t;
+
+/* The work of one iteration of a port's main loop, the same for every port
+ * (wc_tcu on SocketCAN, the loop tests with a mocked port): queue frame (NULL
+ * when the port's wait ended without one), then step when the clock says so:
+ * tick, or with WC_LOOP_CLOCK_FRAME a ClutchSensors data frame. Returns the
+ * number of frames written to out for the port to transmit (0 when no step). */
+uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
+                         wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* Receive filter ids for the port (the frames wc_loop_receive uses). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \

@@ -6,6 +6,17 @@
 
 #include "wetclutch/wetclutch.h"
 
+/* Sizes the loop relies on. */
+WC_STATIC_ASSERT((WC_LOOP_RX_CAPACITY & (WC_LOOP_RX_CAPACITY - 1u)) == 0u, rx_ring_is_a_power_of_two);
+WC_STATIC_ASSERT(WC_LOOP_RX_CAPACITY >= 2u * WC_LOOP_RX_ID_COUNT, rx_ring_holds_two_periods_of_input);
+WC_STATIC_ASSERT(WC_LOOP_TX_FRAMES == 2u, tx_is_vfs_command_and_clutch_estimate);
+WC_STATIC_ASSERT(WC_CAN_CLUTCH_SENSORS_LENGTH == WC_E2E_FRAME_BYTES, clutch_sensors_is_an_e2e_frame);
+WC_STATIC_ASSERT(WC_CAN_TORQUE_REQUEST_LENGTH == WC_E2E_FRAME_BYTES, torque_request_is_an_e2e_frame);
+WC_STATIC_ASSERT(WC_CAN_VFS_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, vfs_command_is_an_e2e_frame);
+WC_STATIC_ASSERT(WC_CAN_CLUTCH_ESTIMATE_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), clutch_estimate_fits_a_frame);
+WC_STATIC_ASSERT(WC_CAN_BENCH_MEASUREMENT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), bench_fits_a_frame);
+WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_word_is_16_bits);
+
 static void input_reset(wc_loop_input_t *in)
 {
     in->age_periods = 0u;
@@ -17,6 +28,7 @@ static void input_reset(wc_loop_input_t *in)
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC)
 {
+    WC_ASSERT((loop != NULL) && (config != NULL));
     if ((loop == NULL) || (config == NULL)) { return WC_CAL_NULL; }
     memset(loop, 0, sizeof *loop);
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
@@ -42,20 +54,26 @@ static void reject(wc_loop_t *loop, wc_loop_reject_t reason)
     loop->pending_status = (uint16_t)(loop->pending_status | flag[reason]);
 }
 
+/* Producer side of the single-producer/single-consumer ring: writes only
+ * rx[], rx_tail, counters.frames_in and counters.rejected[WC_REJECT_OVERFLOW]. */
 bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame)
 {
+    WC_ASSERT((loop != NULL) && (frame != NULL));
     loop->counters.frames_in++;
-    if (loop->rx_count >= WC_LOOP_RX_CAPACITY) {
-        reject(loop, WC_REJECT_OVERFLOW);
+    const uint32_t tail = loop->rx_tail;
+    if ((tail - loop->rx_head) >= WC_LOOP_RX_CAPACITY) {
+        loop->counters.rejected[WC_REJECT_OVERFLOW]++;  /* no status bit: pending_status is the consumer's */
         return false;
     }
-    loop->rx[(loop->rx_head + loop->rx_count) % WC_LOOP_RX_CAPACITY] = *frame;
-    loop->rx_count++;
+    loop->rx[tail % WC_LOOP_RX_CAPACITY] = *frame;
+    WC_MEMORY_BARRIER();        /* the frame is written before it is published */
+    loop->rx_tail = tail + 1u;
     return true;
 }
 
 void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed)
 {
+    WC_ASSERT(loop != NULL);
     loop->counters.deadline_misses += missed;
     if (missed > 0u) { loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_DEADLINE_MISS); }
 }
@@ -181,10 +199,15 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
-    for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (loop->rx_count > 0u); ++i) {
-        process(loop, &loop->rx[loop->rx_head]);
-        loop->rx_head = (loop->rx_head + 1u) % WC_LOOP_RX_CAPACITY;
-        loop->rx_count--;
+    WC_ASSERT((loop != NULL) && (out != NULL));
+    WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
+    /* Consumer side of the ring: writes only rx_head. */
+    for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (loop->rx_head != loop->rx_tail); ++i) {
+        const uint32_t head = loop->rx_head;
+        WC_MEMORY_BARRIER();        /* the frame is read after its publication was seen */
+        process(loop, &loop->rx[head % WC_LOOP_RX_CAPACITY]);
+        WC_MEMORY_BARRIER();        /* ...and fully read before its slot is released */
+        loop->rx_head = head + 1u;  /* free-running: wraps at 2^32, a multiple of the capacity */
     }
     uint16_t bits = loop->pending_status;
     loop->pending_status = 0u;
@@ -217,4 +240,17 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
     loop->counters.steps++;
     loop->counters.frames_out += WC_LOOP_TX_FRAMES;
     return WC_LOOP_TX_FRAMES;
+}
+
+uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
+                         wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    WC_ASSERT((loop != NULL) && (out != NULL));
+    bool step_now = tick;
+    if (frame != NULL) {
+        (void)wc_loop_receive(loop, frame);  /* a refusal is counted (WC_REJECT_OVERFLOW) */
+        step_now = step_now || ((clock == WC_LOOP_CLOCK_FRAME) && (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) &&
+                                (frame->flags == 0u));
+    }
+    return step_now ? wc_loop_step(loop, out) : 0u;
 }

@@ -64,37 +64,41 @@ wc_cal_error_t wc_calibration_check(const wc_calibration_t *cal)
     return check_film(&cal->film);
 }
 
+/* Indexed by wc_cal_error_t, in its order: a code added without a name fails to compile. */
+static const char *const cal_error_names[] = {
+    "ok",
+    "calibration (NULL)",
+    "outer_radius_m",
+    "inner_radius_m",
+    "friction_area_m2",
+    "piston_area_m2",
+    "friction_pairs",
+    "oil_conductance_W_per_K",
+    "housing_conductance_W_per_K",
+    "heat_capacity_J_per_K",
+    "viscosity_a1_Pa_s",
+    "viscosity_b1_per_K",
+    "viscosity_a2_Pa_s",
+    "viscosity_b2_per_K",
+    "mu1",
+    "mu2",
+    "mu3",
+    "stribeck_speed_m_s",
+    "theta1_degC",
+    "theta2_K",
+    "vfs_gain_Pa_per_mA",
+    "vfs_time_constant_s",
+    "return_spring_force_N",
+    "vfs_current_min_mA",
+    "vfs_current_max_mA",
+    "control_period_s",
+    "film (table arrays, length or entries)",
+    "film.pressure_Pa (not strictly increasing)",
+};
+WC_STATIC_ASSERT(sizeof cal_error_names / sizeof cal_error_names[0] == (size_t)WC_CAL_ERRORS,
+                 cal_error_names_cover_every_code);
+
 const char *wc_cal_error_name(wc_cal_error_t error)
 {
-    switch (error) {
-    case WC_CAL_OK: return "ok";
-    case WC_CAL_NULL: return "calibration (NULL)";
-    case WC_CAL_OUTER_RADIUS: return "outer_radius_m";
-    case WC_CAL_INNER_RADIUS: return "inner_radius_m";
-    case WC_CAL_FRICTION_AREA: return "friction_area_m2";
-    case WC_CAL_PISTON_AREA: return "piston_area_m2";
-    case WC_CAL_FRICTION_PAIRS: return "friction_pairs";
-    case WC_CAL_OIL_CONDUCTANCE: return "oil_conductance_W_per_K";
-    case WC_CAL_HOUSING_CONDUCTANCE: return "housing_conductance_W_per_K";
-    case WC_CAL_HEAT_CAPACITY: return "heat_capacity_J_per_K";
-    case WC_CAL_VISCOSITY_A1: return "viscosity_a1_Pa_s";
-    case WC_CAL_VISCOSITY_B1: return "viscosity_b1_per_K";
-    case WC_CAL_VISCOSITY_A2: return "viscosity_a2_Pa_s";
-    case WC_CAL_VISCOSITY_B2: return "viscosity_b2_per_K";
-    case WC_CAL_MU1: return "mu1";
-    case WC_CAL_MU2: return "mu2";
-    case WC_CAL_MU3: return "mu3";
-    case WC_CAL_STRIBECK_SPEED: return "stribeck_speed_m_s";
-    case WC_CAL_THETA1: return "theta1_degC";
-    case WC_CAL_THETA2: return "theta2_K";
-    case WC_CAL_VFS_GAIN: return "vfs_gain_Pa_per_mA";
-    case WC_CAL_VFS_TIME_CONSTANT: return "vfs_time_constant_s";
-    case WC_CAL_RETURN_SPRING_FORCE: return "return_spring_force_N";
-    case WC_CAL_VFS_CURRENT_MIN: return "vfs_current_min_mA";
-    case WC_CAL_VFS_CURRENT_MAX: return "vfs_current_max_mA";
-    case WC_CAL_CONTROL_PERIOD: return "control_period_s";
-    case WC_CAL_FILM_TABLE: return "film (table arrays, length or entries)";
-    case WC_CAL_FILM_AXIS_NOT_MONOTONE: return "film.pressure_Pa (not strictly increasing)";
-    default: return "unknown";
-    }
+    return ((unsigned)error < (unsigned)WC_CAL_ERRORS) ? cal_error_names[error] : "unknown";
 }

@@ -7,8 +7,12 @@
 #include "wc_internal.h"
 #include "wetclutch/wc_thermal.h"
 
+/* DESIGN section 3 / issue "state <= 64 B per clutch" (48 B on Cortex-M4F, 56 B on a 64-bit host). */
+WC_STATIC_ASSERT(sizeof(wc_clutch_t) <= 64u, clutch_state_fits_in_64_bytes);
+
 wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, float theta_start_degC)
 {
+    WC_ASSERT(clutch != NULL);
     if (clutch == NULL) { return WC_CAL_NULL; }
     const wc_cal_error_t error = wc_model_init(&clutch->model, cal);
     if (error != WC_CAL_OK) { return error; }
@@ -39,6 +43,8 @@ static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *
 
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
 {
+    WC_ASSERT((clutch != NULL) && (in != NULL) && (out != NULL));
+    WC_ASSERT(clutch->model.cal != NULL);  /* initialised, and its init succeeded */
     const wc_model_t *model = &clutch->model;
     wc_status_t status = accept_inputs(&clutch->held, in);
     const wc_held_inputs_t *u = &clutch->held;

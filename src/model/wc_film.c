@@ -1,9 +1,12 @@
 #include "wetclutch/wc_film.h"
 
+#include <stddef.h>
+
 #include "wetclutch/wc_config.h"
 
 float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
 {
+    WC_ASSERT(table != NULL);
     const float *p = table->pressure_Pa;
     const uint32_t last = table->length - 1u;
     /* Clamp; the negated compare also sends NaN to the open-clutch end. */

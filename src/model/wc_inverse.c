@@ -16,6 +16,8 @@ static void finish(const wc_model_t *model, float force_N, wc_status_t *status, 
 wc_status_t wc_inverse(const wc_model_t *model, float slip_rad_s, float theta_degC,
                        float torque_request_Nm, wc_inverse_t *out)
 {
+    WC_ASSERT((model != NULL) && (model->cal != NULL));
+    WC_ASSERT(out != NULL);
     wc_status_t status = WC_STATUS_OK;
     out->iterations = 0u;
     if (!wc_slip_valid(slip_rad_s)) { status |= WC_STATUS_SLIP_INVALID; }

@@ -3,8 +3,11 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "wetclutch/wc_config.h"
+
 wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
 {
+    WC_ASSERT(model != NULL);
     if (model == NULL) { return WC_CAL_NULL; }
     model->cal = NULL;
     const wc_cal_error_t error = wc_calibration_check(cal);

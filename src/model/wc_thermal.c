@@ -7,6 +7,8 @@
 wc_status_t wc_thermal_step(const wc_model_t *model, float *theta_degC, float power_W,
                             float theta_oil_degC, float theta_housing_degC)
 {
+    WC_ASSERT((model != NULL) && (model->cal != NULL));
+    WC_ASSERT(theta_degC != NULL);
     wc_status_t status = WC_STATUS_OK;
     if (!(isfinite(power_W) && (power_W >= 0.0f))) { status |= WC_STATUS_POWER_INVALID; }
     if (!wc_theta_valid(theta_oil_degC) || !wc_theta_valid(theta_housing_degC)) {

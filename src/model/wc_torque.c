@@ -31,6 +31,8 @@ float wc_torque_point_magnitude(const wc_model_t *model, const wc_torque_point_t
 wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_degC, float force_N,
                       wc_torque_t *out)
 {
+    WC_ASSERT((model != NULL) && (model->cal != NULL));
+    WC_ASSERT(out != NULL);
     wc_status_t status = WC_STATUS_OK;
     if (!wc_slip_valid(slip_rad_s)) { status |= WC_STATUS_SLIP_INVALID; }
     if (!wc_theta_valid(theta_degC)) { status |= WC_STATUS_THETA_INVALID; }

@@ -1,6 +1,7 @@
 /* wc_tcu: the TCU program. Runs the portable frame loop (wc_loop) of one
  * clutch on a SocketCAN interface.
- *   --clock timer  steps at absolute deadlines (clock_nanosleep), counts misses
+ *   --clock timer  steps at deadlines a fixed period apart (the receive wait,
+ *                  ppoll, is bounded by the next deadline), counts misses
  *   --clock frame  one step per received ClutchSensors frame, so that replaying
  *                  one log twice gives byte-identical output frames
  * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit seconds without a
@@ -10,6 +11,7 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <getopt.h>
+#include <stdbool.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -17,6 +19,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
 #include "wc_socketcan.h"
 #include "wc_tcu_calibrations.h"
@@ -151,10 +154,9 @@ static int parse_options(int argc, char **argv, options_t *o)
     return 0;
 }
 
-static const char *const reject_names[WC_REJECT_REASONS] = {
-    [WC_REJECT_CRC] = "crc", [WC_REJECT_COUNTER] = "counter", [WC_REJECT_SHORT] = "short",
-    [WC_REJECT_UNKNOWN_ID] = "unknown_id", [WC_REJECT_FORMAT] = "format",
-    [WC_REJECT_IMPLAUSIBLE] = "implausible", [WC_REJECT_OVERFLOW] = "overflow"};
+/* Indexed by wc_loop_reject_t, in its order: a reason added without a name fails to compile. */
+static const char *const reject_names[] = {"crc", "counter", "short", "unknown_id", "format", "implausible", "overflow"};
+WC_STATIC_ASSERT(sizeof reject_names / sizeof reject_names[0] == WC_REJECT_REASONS, reject_names_cover_every_reason);
 
 static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, uint32_t rx_dropped,
                    const step_times_t *h)
@@ -229,8 +231,8 @@ int main(int argc, char **argv)
     int status = 0;
     int64_t last_rx = -1;  /* the idle timer starts with the first frame */
     int64_t deadline = now_ns() + opt.period_ns;
+    const wc_loop_clock_t clock = opt.frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
     while (!stop_requested && (opt.max_steps == 0 || loop.counters.steps < opt.max_steps)) {
-        int step_now = 0;
         wc_can_frame_t frame;
         const int64_t wait_ns = opt.frame_clock ? 100000000LL : deadline - now_ns();
         const int got = (wait_ns > 0) ? wc_socketcan_receive(&port, &frame, wait_ns / 1000) : 0;
@@ -242,13 +244,12 @@ int main(int argc, char **argv)
         const int64_t t = now_ns();
         if (got == 1) {
             last_rx = t;
-            (void)wc_loop_receive(&loop, &frame);
-            step_now = opt.frame_clock && (frame.id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && frame.flags == 0u;
         } else if (opt.idle_exit_s > 0 && last_rx >= 0 && (double)(t - last_rx) > opt.idle_exit_s * 1e9) {
             break;
         }
+        bool tick = false;
         if (!opt.frame_clock && t >= deadline) {
-            step_now = 1;
+            tick = true;
             deadline += opt.period_ns;
             if (t >= deadline) {  /* late by a whole period or more: skip, count */
                 const int64_t missed = (t - deadline) / opt.period_ns + 1;
@@ -256,10 +257,10 @@ int main(int argc, char **argv)
                 wc_loop_deadline_missed(&loop, (uint32_t)missed);
             }
         }
-        if (!step_now) { continue; }
         const int64_t t0 = now_ns();
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
-        const uint32_t n = wc_loop_step(&loop, out);
+        const uint32_t n = wc_loop_iterate(&loop, clock, (got == 1) ? &frame : NULL, tick, out);
+        if (n == 0u) { continue; }
         for (uint32_t i = 0; i < n; ++i) {
             if (wc_socketcan_send(&port, &out[i]) != 0) {
                 if (tx_errors == 0) { fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port.error); }

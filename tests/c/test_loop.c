@@ -1,5 +1,5 @@
-/* cmocka tests of the CAN frame loop (include/wc_loop.h, src/wc_loop.c) with
- * the port mocked.
+/* cmocka tests of the CAN frame loop (include/wetclutch_can/wc_loop.h,
+ * src/can/wc_loop.c) with the port mocked.
  *
  * The mock port stands in for SocketCAN (src/port/wc_socketcan.c):
  *   mock_port_receive  hands out what a test queued with will_return: a frame
@@ -9,13 +9,14 @@
  *   mock_port_send     checks id, DLC and flags of every frame it is asked to
  *                      send against expect_value (VfsCommand, then
  *                      ClutchEstimate, DLC 8, no flags) and records it.
- * drive() is the main loop of src/port/wc_tcu.c with --clock frame: every
- * received frame goes to wc_loop_receive, a ClutchSensors frame without flags
- * ends the period (one wc_loop_step) and the step's frames are sent through
- * the port. PORT_TICK steps like a deadline of --clock timer; the tests use it
- * only where a period without any ClutchSensors frame is the point.
+ * drive() runs the main loop of src/port/wc_tcu.c with --clock frame through
+ * the same wc_loop_iterate: every received frame is queued, a ClutchSensors
+ * frame without flags ends the period (one wc_loop_step) and the step's
+ * frames are sent through the port. PORT_TICK steps like a deadline of
+ * --clock timer; the tests use it only where a period without any
+ * ClutchSensors frame is the point.
  *
- * Frames are built with the encoders of src/can/wc_can_scaling.h; implausible
+ * Frames are built with the generated encoders (wc_can_signals.h); implausible
  * raw values are packed with the generated pack functions and protected with
  * wc_e2e_protect, so that only plausibility fails.
  *
@@ -121,8 +122,9 @@ static void expect_step_frames(void)
     expect_value(mock_port_send, frame_flags, 0u);
 }
 
-/* wc_tcu's loop, --clock frame (see the top of the file), until PORT_END.
- * Returns the number of steps. */
+/* wc_tcu's main loop, --clock frame, until PORT_END: the same
+ * wc_loop_iterate that wc_tcu calls, fed by the mocked port. PORT_TICK steps
+ * without a frame (the timer clock's deadline). Returns the number of steps. */
 static uint32_t drive(wc_loop_t *loop)
 {
     uint32_t steps = 0u;
@@ -131,17 +133,17 @@ static uint32_t drive(wc_loop_t *loop)
         memset(&frame, 0, sizeof frame);
         const int event = mock_port_receive(&frame);
         if (event == PORT_END) { break; }
-        bool step_now = (event == PORT_TICK);
-        if (event == PORT_FRAME) {
-            tx_log.offered++;
-            if (!wc_loop_receive(loop, &frame)) { tx_log.refused++; }
-            step_now = (frame.id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame.flags == 0u);
-        }
-        if (!step_now) { continue; }
+        const uint32_t overflows = loop->counters.rejected[WC_REJECT_OVERFLOW];
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
         memset(out, 0xA5, sizeof out);  /* a field the loop forgets to write shows */
-        expect_step_frames();
-        const uint32_t n = wc_loop_step(loop, out);
+        const bool tick = (event == PORT_TICK);
+        if (tick || ((frame.id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame.flags == 0u))) { expect_step_frames(); }
+        const uint32_t n = wc_loop_iterate(loop, WC_LOOP_CLOCK_FRAME, (event == PORT_FRAME) ? &frame : NULL, tick, out);
+        if (event == PORT_FRAME) {
+            tx_log.offered++;
+            if (loop->counters.rejected[WC_REJECT_OVERFLOW] != overflows) { tx_log.refused++; }
+        }
+        if (n == 0u) { continue; }
         assert_int_equal(n, WC_LOOP_TX_FRAMES);
         for (uint32_t i = 0u; i < n; ++i) {
             assert_int_equal(mock_port_send(&out[i]), 0);
