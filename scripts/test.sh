@@ -10,12 +10,18 @@ echo "== build: host-debug (address + undefined sanitizers)"
 cmake --preset host-debug >/dev/null
 cmake --build --preset host-debug
 
+echo "== static analysis (cppcheck gating; MISRA C:2012 counts)"
+bash scripts/static_analysis.sh build/host-debug
+
 echo "== build: host-release (wc_tcu for the vcan and HIL tests, wc_eval)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release
 
 echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
 bash scripts/check_arm.sh
+
+echo "== package: find_package(wetclutch) after install, and add_subdirectory(), host and Cortex-M4F"
+bash scripts/check_package.sh
 
 echo "== C unit tests (ctest)"
 ctest --test-dir build/host-debug --output-on-failure

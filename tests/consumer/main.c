@@ -1,9 +1,13 @@
-/* Consumer of the installed or add_subdirectory()'d library: init one clutch
- * from the generated table1 calibration, step it once, check the answer. */
+/* Consumer of the installed or add_subdirectory()'d libraries: init one
+ * clutch from the generated table1 calibration, step it once, check the
+ * answer; then one period of the CAN frame loop (wetclutch_can). */
 #include <stdio.h>
 
 #include <wetclutch/wetclutch.h>
+#include <wetclutch_can/wc_loop.h>
 #include "wc_table1_calibration.h"
+
+static wc_loop_t loop;  /* large (receive ring): static storage */
 
 int main(void)
 {
@@ -26,5 +30,11 @@ int main(void)
            (unsigned)status, (double)out.current_mA, (double)out.force_command_N,
            (unsigned)out.inverse_iterations);
     const int ok = (status == WC_STATUS_OK) && (out.current_mA > 0.0f) && (out.force_command_N > 0.0f);
-    return ok ? 0 : 1;
+
+    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    wc_can_frame_t tx[WC_LOOP_TX_FRAMES];
+    const int loop_ok = (wc_loop_init(&loop, &wc_table1_calibration, &config, 80.0f) == WC_CAL_OK) &&
+                        (wc_loop_step(&loop, tx) == WC_LOOP_TX_FRAMES) && (tx[0].id == WC_CAN_VFS_COMMAND_FRAME_ID);
+    printf("wc_consumer: loop step sent 0x%03x (no input yet: safe state)\n", (unsigned)tx[0].id);
+    return (ok && loop_ok) ? 0 : 1;
 }
