@@ -199,15 +199,6 @@ state_bytes=$(symsize wc_probe_sizeof_clutch)
 model_bytes=$(symsize wc_probe_sizeof_model)
 max_iterations=$(symsize wc_probe_inverse_max_iterations)
 
-# Iterations the bisection needs for table1: the bracket [0, F_max] halves
-# until it is at most WC_INVERSE_FORCE_TOLERANCE_N wide.
-lut_value() { sed -n "s/^ *\.$1 = \([-0-9.eE+]*\)f.*/\1/p" lut/wc_table1_calibration.h; }
-tolerance=$(sed -n 's/^#define WC_INVERSE_FORCE_TOLERANCE_N \([0-9.eE+-]*\)f.*/\1/p' include/wetclutch/wc_config.h)
-read -r force_max needed < <(awk -v k="$(lut_value vfs_gain_Pa_per_mA)" -v i="$(lut_value vfs_current_max_mA)" \
-  -v a="$(lut_value piston_area_m2)" -v fs="$(lut_value return_spring_force_N)" -v tol="$tolerance" 'BEGIN {
-    f = k * i * a - fs; n = 0; w = f; while (w > tol) { w /= 2; n++ }
-    printf "%.1f %d\n", f, n }')
-
 # Stack: own frames (.su) summed along the call graph (.ci); functions outside
 # the library (expf and what it calls) from their prologues in the linked image.
 stack_report=$(python3 - "$build/src/model/CMakeFiles/wetclutch.dir:$build/src/can/CMakeFiles/wetclutch_can.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
@@ -329,8 +320,7 @@ arm-none-eabi-gcc $gcc_version, preset $preset: -mcpu=cortex-m4 -mthumb -mfloat-
 | state per clutch, sizeof(wc_clutch_t) | $state_bytes B (of which wc_model_t $model_bytes B) | $(goal "$state_bytes" 64) |
 | worst stack, public entry point | $worst_public B, $worst_public_name | $(goal "$worst_public" 256) |
 | stack of wc_clutch_step | $step_stack B | |
-| inverse: WC_INVERSE_MAX_ITERATIONS | $max_iterations | compile-time bound |
-| inverse: iterations needed for table1 | $needed = ceil(log2($force_max N / $tolerance N)) | F_max = K i_max A_p - F_s |
+| inverse: WC_INVERSE_MAX_ITERATIONS | $max_iterations | compile-time bound on the Newton steps |
 
 Worst chain: $worst_public_path
 

@@ -45,14 +45,15 @@
 #define WC_TORQUE_MAX_Nm 100000.0f
 #endif
 
-/* Bisection of the inverse: stop when the force bracket is this narrow... */
+/* The inverse (wc_inverse.c): Newton steps on the film segment that holds
+ * the root stop once a step moves the force by less than half this... */
 #ifndef WC_INVERSE_FORCE_TOLERANCE_N
 #define WC_INVERSE_FORCE_TOLERANCE_N 0.01f
 #endif
-/* ...or after this many halvings, so the worst case is known at compile time.
- * 2^24 halvings of a 100 kN bracket reach 0.006 N, below the tolerance. */
+/* ...or after this many steps, so the worst case is known at compile time
+ * (2 to 3 are typical; a step that would leave the segment bisects it). */
 #ifndef WC_INVERSE_MAX_ITERATIONS
-#define WC_INVERSE_MAX_ITERATIONS 24u
+#define WC_INVERSE_MAX_ITERATIONS 8u
 #endif
 
 /* Keep a helper out of its caller's stack frame (the stack figure is the sum

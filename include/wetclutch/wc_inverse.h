@@ -1,7 +1,8 @@
 /* Torque request -> contact force -> piston pressure -> VFS current.
- * T(F_c) is strictly increasing in F_c (eq. 8), so a bounded bisection finds
- * the unique force: at most WC_INVERSE_MAX_ITERATIONS halvings, stopping once
- * the bracket is narrower than WC_INVERSE_FORCE_TOLERANCE_N. */
+ * T(F_c) is strictly increasing in F_c (eq. 8), so the force is unique: a
+ * binary search over the film table's nodes finds the segment that holds it,
+ * then at most WC_INVERSE_MAX_ITERATIONS safeguarded Newton steps on that
+ * segment's cubic, to within WC_INVERSE_FORCE_TOLERANCE_N (src/model/wc_inverse.c). */
 #ifndef WC_INVERSE_H
 #define WC_INVERSE_H
 
@@ -14,7 +15,7 @@ typedef struct {
     float force_N;        /* contact force F_c */
     float pressure_Pa;    /* piston pressure (F_c + F_s) / A_p */
     float current_mA;     /* VFS current, within the solenoid range */
-    uint32_t iterations;  /* bisection halvings used */
+    uint32_t iterations;  /* Newton steps used (0: below drag, saturated, or outside the table) */
 } wc_inverse_t;
 
 /* torque_request_Nm is a magnitude (>= 0): the clutch torque wanted against

@@ -11,6 +11,7 @@ typedef struct {
     float effective_radius_m;   /* R_eff, eq. 3 */
     float torque_arm_m;         /* R_eff N_c: torque per unit of friction force, eq. 6-8 */
     float force_max_N;          /* contact force at the solenoid's maximum current */
+    float hbar_at_force_max_m;  /* h_bar(force_max_N / A_f): the inverse's saturation test */
     float thermal_decay;        /* a = exp(-(k1 + k2) dt / C), eq. 1 exact ZOH */
     float vfs_decay;            /* exp(-dt / tau), VFS first-order lag */
 } wc_model_t;

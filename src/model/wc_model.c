@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "wetclutch/wc_config.h"
+#include "wetclutch/wc_film.h"
 
 wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
 {
@@ -22,6 +23,7 @@ wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
     const float force_at_max_N = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 -
                                  cal->return_spring_force_N;
     model->force_max_N = (force_at_max_N > 0.0f) ? force_at_max_N : 0.0f;
+    model->hbar_at_force_max_m = wc_film_hbar_m(&cal->film, model->force_max_N / cal->friction_area_m2);
     /* eq. 1, exact for a zero-order-hold input: computed once here, never per step */
     const float k_total_W_per_K = cal->oil_conductance_W_per_K + cal->housing_conductance_W_per_K;
     model->thermal_decay = expf(-k_total_W_per_K * cal->control_period_s / cal->heat_capacity_J_per_K);

@@ -6,7 +6,7 @@
 #include "wetclutch/wc_film.h"
 #include "wetclutch/wc_friction.h"
 #include "wc_internal.h"
-#include "wc_torque_point.h"
+#include "wc_operating_point.h"
 #include "wetclutch/wc_viscosity.h"
 
 void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point)
@@ -19,13 +19,26 @@ void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC
                           cal->friction_area_m2 * speed_m_s;
 }
 
-float wc_torque_point_magnitude(const wc_model_t *model, const wc_torque_point_t *point, float force_N,
-                                float *hbar_m)
+void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out)
+{
+    out->torque_Nm = 0.0f;
+    out->coulomb_Nm = 0.0f;
+    out->viscous_Nm = 0.0f;
+    out->hbar_m = model->cal->film.hbar_m[0];
+    out->mu_f = 0.0f;
+}
+
+void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
+                        wc_torque_t *out)
 {
     /* eq. 16: steady film, p_c = F_c / A_f */
-    const float hbar = wc_film_hbar_m(&model->cal->film, force_N / model->cal->friction_area_m2);
-    *hbar_m = hbar;
-    return point->coulomb_Nm_per_N * force_N + point->viscous_Nm_m / hbar;                  /* eq. 8 */
+    const float hbar_m = wc_film_hbar_m(&model->cal->film, force_N / model->cal->friction_area_m2);
+    const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
+    out->coulomb_Nm = sign * point->coulomb_Nm_per_N * force_N;   /* eq. 6 */
+    out->viscous_Nm = sign * point->viscous_Nm_m / hbar_m;        /* eq. 7 */
+    out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;           /* eq. 5 */
+    out->hbar_m = hbar_m;
+    out->mu_f = point->mu_f;
 }
 
 wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_degC, float force_N,
@@ -38,22 +51,11 @@ wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_deg
     if (!wc_theta_valid(theta_degC)) { status |= WC_STATUS_THETA_INVALID; }
     if (!wc_in_range(force_N, 0.0f, WC_FORCE_MAX_N)) { status |= WC_STATUS_FORCE_INVALID; }
     if (status != WC_STATUS_OK) {
-        out->torque_Nm = 0.0f;
-        out->coulomb_Nm = 0.0f;
-        out->viscous_Nm = 0.0f;
-        out->hbar_m = model->cal->film.hbar_m[0];
-        out->mu_f = 0.0f;
+        wc_torque_rejected(model, out);
         return status;
     }
     wc_torque_point_t point;
     wc_torque_point(model, slip_rad_s, theta_degC, &point);
-    float hbar_m = 0.0f;
-    (void)wc_torque_point_magnitude(model, &point, force_N, &hbar_m);
-    const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
-    out->coulomb_Nm = sign * point.coulomb_Nm_per_N * force_N;   /* eq. 6 */
-    out->viscous_Nm = sign * point.viscous_Nm_m / hbar_m;        /* eq. 7 */
-    out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;          /* eq. 5 */
-    out->hbar_m = hbar_m;
-    out->mu_f = point.mu_f;
+    wc_torque_at_point(model, &point, slip_rad_s, force_N, out);
     return WC_STATUS_OK;
 }

@@ -33,6 +33,44 @@ static int32_t raw_of(const wc_can_signal_t *sig, float value,
 
 /* ---- CRC-8 SAE J1850 ----------------------------------------------------- */
 
+/* CRC-8 SAE J1850 by its definition: eight conditional shifts a byte
+ * (polynomial 0x1D, init 0xFF, xor-out 0xFF, not reflected). The library
+ * uses a nibble table; every single byte after every register value, and
+ * a pseudo-random message, must agree. */
+static uint8_t crc8_bitwise(const uint8_t *data, size_t len)
+{
+    uint8_t reg = 0xFFu;
+    for (size_t i = 0u; i < len; ++i) {
+        reg = (uint8_t)(reg ^ data[i]);
+        for (unsigned bit = 0u; bit < 8u; ++bit) {
+            reg = (uint8_t)(((reg & 0x80u) != 0u) ? (((unsigned)reg << 1) ^ 0x1Du) : ((unsigned)reg << 1));
+        }
+    }
+    return (uint8_t)(reg ^ 0xFFu);
+}
+
+static void test_crc8_table_matches_bitwise(void **state)
+{
+    (void)state;
+    uint8_t two[2];
+    for (unsigned a = 0u; a < 256u; ++a) {
+        for (unsigned b = 0u; b < 256u; ++b) {
+            two[0] = (uint8_t)a;
+            two[1] = (uint8_t)b;
+            assert_int_equal(wc_e2e_crc8_j1850(two, 2u), crc8_bitwise(two, 2u));
+        }
+    }
+    uint8_t message[64];
+    uint32_t x = 12345u;
+    for (size_t i = 0u; i < sizeof message; ++i) {
+        x = x * 1103515245u + 12345u;
+        message[i] = (uint8_t)(x >> 24);
+    }
+    for (size_t len = 0u; len <= sizeof message; ++len) {
+        assert_int_equal(wc_e2e_crc8_j1850(message, len), crc8_bitwise(message, len));
+    }
+}
+
 static void test_crc8_autosar_vectors(void **state)
 {
     /* AUTOSAR SWS CRC Library, Crc_CalculateCRC8 (SAE J1850) check values. */
@@ -588,6 +626,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_crc8_autosar_vectors),
+        cmocka_unit_test(test_crc8_table_matches_bitwise),
         cmocka_unit_test(test_frame_crc_covers_data_id_and_bytes_1_to_7),
         cmocka_unit_test(test_counter_sequence_and_wrap),
         cmocka_unit_test(test_counter_repeat_and_jump),

@@ -3,8 +3,10 @@
 #include "wc_test_support.h"
 
 #include <float.h>
+#include <stdio.h>
 
 #include "wc_golden_vectors.h"
+#include "wc_operating_point.h"  /* internal: the inverse's power-basis form of a segment */
 #include "wc_table1_calibration.h"
 
 static const wc_film_table_t *table1(void) { return &wc_table1_calibration.film; }
@@ -204,6 +206,33 @@ static void test_hermite_reproduces_a_cubic(void **state)
     }
 }
 
+/* The inverse solves on each segment's cubic in the power basis
+ * (wc_film_segment_cubic); it must be the interpolant wc_film_hbar_m
+ * evaluates, to float rounding: 32 points per segment, relative 1e-5
+ * (a few float roundings of terms that partly cancel near the nodes). */
+static void test_segment_cubic_is_the_interpolant(void **state)
+{
+    (void)state;
+    const wc_film_table_t *t = table1();
+    double worst = 0.0;
+    for (uint32_t k = 0u; k + 1u < t->length; ++k) {
+        float c[4];
+        wc_film_segment_cubic(t, k, c);
+        for (int j = 0; j <= 32; ++j) {
+            const float u = (float)j / 32.0f;
+            const float p = t->pressure_Pa[k] + u * (t->pressure_Pa[k + 1u] - t->pressure_Pa[k]);
+            if (!(p < t->pressure_Pa[k + 1u])) { continue; }  /* the last point rounds onto the next node */
+            const double power = (double)(c[0] + u * (c[1] + u * (c[2] + u * c[3])));
+            const double hermite = (double)wc_film_hbar_m(t, p);
+            const double rel = fabs(power - hermite) / hermite;
+            if (rel > worst) { worst = rel; }
+            WC_CHECK(rel <= 1e-5, "segment %u, t %g: power basis %.9g, Hermite %.9g", (unsigned)k, (double)u,
+                     power, hermite);
+        }
+    }
+    printf("    segment cubic vs wc_film_hbar_m: max relative difference %.3g (allowed 1e-5)\n", worst);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -214,6 +243,7 @@ int main(void)
         cmocka_unit_test(test_clamps_both_ends_and_nan),
         cmocka_unit_test(test_strictly_decreasing_in_pressure),
         cmocka_unit_test(test_hermite_reproduces_a_cubic),
+        cmocka_unit_test(test_segment_cubic_is_the_interpolant),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,44 @@
+/* Internal: the model at one operating point (slip, theta), where only the
+ * film depends on the force. mu_f and mu_v (up to three expf) are computed
+ * once per control step and shared by the inverse and the forward torque
+ * (wc_clutch_step); the public wc_torque and wc_inverse compute their own. */
+#ifndef WC_OPERATING_POINT_H
+#define WC_OPERATING_POINT_H
+
+#include <stdint.h>
+
+#include "wetclutch/wc_inverse.h"
+#include "wetclutch/wc_model.h"
+#include "wetclutch/wc_status.h"
+#include "wetclutch/wc_torque.h"
+
+typedef struct {
+    float coulomb_Nm_per_N;  /* R_eff N_c mu_f(v, theta), eq. 6 */
+    float viscous_Nm_m;      /* R_eff N_c mu_v(theta) A_f v, eq. 7 times h_bar */
+    float mu_f;
+} wc_torque_point_t;
+
+/* mu_f, mu_v at a valid (slip, theta). */
+void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point);
+
+/* eq. 5-8 at the point for a valid force_N, signed with the slip. */
+void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
+                        wc_torque_t *out);
+
+/* The inverse at the point for a valid torque_request_Nm (wc_inverse.h). */
+wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
+                                wc_inverse_t *out);
+
+/* The documented answers to rejected input (wc_torque.h, wc_inverse.h):
+ * zero torque with the open-clutch film; no contact force. status carries
+ * the input bits and gains the current clamp bit if the preload current is
+ * outside the solenoid range. */
+void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out);
+wc_status_t wc_inverse_rejected(const wc_model_t *model, wc_status_t status, wc_inverse_t *out);
+
+/* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]
+ * (p = p_k + t (p_k+1 - p_k)): h_bar(t) = c[0] + t (c[1] + t (c[2] + t c[3])).
+ * The same cubic Hermite as wc_film_hbar_m, in the power basis (eq. 9, 15, 16). */
+void wc_film_segment_cubic(const wc_film_table_t *table, uint32_t k, float coefficient[4]);
+
+#endif /* WC_OPERATING_POINT_H */
