@@ -129,7 +129,7 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
         out->force_N = model->force_max_N;
         out->current_mA = cal->vfs_current_max_mA;
         out->pressure_Pa = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA;
-        return status | WC_STATUS_SATURATED;
+        return WC_STATUS_SATURATED;
     }
 
     const float area_m2 = cal->friction_area_m2;
