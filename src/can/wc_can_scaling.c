@@ -19,11 +19,21 @@ wc_can_result_t wc_can_worst(wc_can_result_t a, wc_can_result_t b)
 
 /* ---- one signal ---------------------------------------------------------- */
 
+/* roundf for |x| <= 2^24: to nearest, ties away from zero. The conversion to
+ * int truncates toward zero and x - t is exact, so this equals roundf
+ * bit for bit, in a handful of instructions instead of a newlib call. */
+static float round_half_away(float x)
+{
+    const float t = (float)(int32_t)x;
+    const float r = x - t;
+    if (r >= 0.5f) { return t + 1.0f; }
+    if (r <= -0.5f) { return t - 1.0f; }
+    return t;
+}
+
 wc_can_result_t wc_can_phys_to_raw(const wc_can_signal_t *sig, float value,
                                    int32_t *raw)
 {
-    float steps;
-
     if ((sig == NULL) || (raw == NULL)) {
         return WC_CAN_ERR_SIZE;
     }
@@ -32,8 +42,13 @@ wc_can_result_t wc_can_phys_to_raw(const wc_can_signal_t *sig, float value,
         return WC_CAN_ERR_NAN;
     }
     /* Every raw limit is below 2^24 in magnitude, so it is exact in float and
-     * the comparisons below decide saturation exactly; +-inf saturates. */
-    steps = roundf((value - sig->offset) / sig->scale);
+     * the comparisons below decide saturation exactly; +-inf saturates. A
+     * value beyond [raw_min - 1, raw_max + 1] saturates before rounding (it
+     * would after rounding too), which keeps round_half_away in its range. */
+    const float unrounded = (value - sig->offset) / sig->scale;
+    const float lowest = (float)sig->raw_min - 1.0f;
+    const float highest = (float)sig->raw_max + 1.0f;
+    const float steps = round_half_away((unrounded < lowest) ? lowest : ((unrounded > highest) ? highest : unrounded));
     if (steps < (float)sig->raw_min) {
         *raw = sig->raw_min;
         return WC_CAN_SATURATED;

@@ -247,6 +247,74 @@ static void test_rounding_decimal_scale_and_offset(void **state)
 
 /* ---- saturation ---------------------------------------------------------- */
 
+/* wc_can_phys_to_raw rounds without newlib's roundf (round_half_away in
+ * wc_can_scaling.c). Against the definition (roundf, then saturate) for every
+ * descriptor: every raw step and the two half-steps around it near both
+ * limits and zero, ties, one float ulp either side of each tie, and
+ * pseudo-random values over 10x the range; results and raw values equal. */
+static wc_can_result_t phys_to_raw_by_definition(const wc_can_signal_t *sig, float value, int32_t *raw)
+{
+    const float steps = roundf((value - sig->offset) / sig->scale);
+    if (steps < (float)sig->raw_min) { *raw = sig->raw_min; return WC_CAN_SATURATED; }
+    if (steps > (float)sig->raw_max) { *raw = sig->raw_max; return WC_CAN_SATURATED; }
+    *raw = (int32_t)steps;
+    return WC_CAN_OK;
+}
+
+static void check_rounding(const wc_can_signal_t *sig, float value)
+{
+    int32_t got = 0;
+    int32_t want = 0;
+    const wc_can_result_t r_got = wc_can_phys_to_raw(sig, value, &got);
+    const wc_can_result_t r_want = phys_to_raw_by_definition(sig, value, &want);
+    if ((r_got != r_want) || (got != want)) {
+        fail_msg("value %.9g (scale %g, offset %g): raw %ld result %d, by definition raw %ld result %d",
+                 (double)value, (double)sig->scale, (double)sig->offset, (long)got, (int)r_got, (long)want,
+                 (int)r_want);
+    }
+}
+
+static void test_rounding_equals_roundf(void **state)
+{
+    (void)state;
+    const wc_can_signal_t *const sigs[] = {
+        &wc_can_sig_clutch_sensors_slip_speed, &wc_can_sig_clutch_sensors_oil_temp,
+        &wc_can_sig_torque_request_torque_request, &wc_can_sig_vfs_command_vfs_current,
+        &wc_can_sig_vfs_command_pressure_command, &wc_can_sig_clutch_estimate_estimated_clutch_temp,
+        &wc_can_sig_clutch_estimate_model_torque, &wc_can_sig_clutch_estimate_mu_f,
+        &wc_can_sig_clutch_estimate_film_thickness, &wc_can_sig_bench_measurement_load_cell_force,
+        &wc_can_sig_bench_measurement_measured_torque,
+    };
+    uint32_t x = 2463534242u;
+    for (size_t k = 0u; k < sizeof sigs / sizeof sigs[0]; ++k) {
+        const wc_can_signal_t *sig = sigs[k];
+        const int32_t anchors[] = { sig->raw_min, 0, sig->raw_max };
+        for (size_t a = 0u; a < 3u; ++a) {
+            for (int32_t d = -300; d <= 300; ++d) {
+                const float raw = (float)(anchors[a] + d);
+                for (int h = -1; h <= 1; ++h) {
+                    const float tie = (raw + 0.5f * (float)h) * sig->scale + sig->offset;
+                    check_rounding(sig, tie);
+                    check_rounding(sig, nextafterf(tie, INFINITY));
+                    check_rounding(sig, nextafterf(tie, -INFINITY));
+                }
+            }
+        }
+        const float span = (float)(sig->raw_max - sig->raw_min) * sig->scale;
+        for (int n = 0; n < 20000; ++n) {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            const float u = (float)(x >> 8) / 16777216.0f;  /* [0, 1) */
+            check_rounding(sig, sig->offset + (float)sig->raw_min * sig->scale + (10.0f * u - 4.5f) * span);
+        }
+        check_rounding(sig, INFINITY);
+        check_rounding(sig, -INFINITY);
+        check_rounding(sig, 3.0e38f);
+        check_rounding(sig, -3.0e38f);
+    }
+}
+
 static void test_saturation_at_both_ends(void **state)
 {
     const wc_can_signal_t *cur = &wc_can_sig_vfs_command_vfs_current;
@@ -627,6 +695,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_crc8_autosar_vectors),
         cmocka_unit_test(test_crc8_table_matches_bitwise),
+        cmocka_unit_test(test_rounding_equals_roundf),
         cmocka_unit_test(test_frame_crc_covers_data_id_and_bytes_1_to_7),
         cmocka_unit_test(test_counter_sequence_and_wrap),
         cmocka_unit_test(test_counter_repeat_and_jump),
