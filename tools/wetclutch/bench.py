@@ -253,26 +253,6 @@ def check_seed(seed) -> int:
     return int(seed)
 
 
-# --------------------------------------------------------------------------- film table
-
-class FilmTable:
-    """Dense double table of eq. 15, inverted by interpolation: h_ss(F_app)."""
-
-    def __init__(self, cal: Calibration, nodes: int):
-        h_min, h_max, p_min, p_max = model.film_domain(cal)
-        self.h_min, self.h_max, self.p_min, self.p_max = h_min, h_max, p_min, p_max
-        self.h = np.linspace(h_min, h_max, nodes)
-        p = model.contact_pressure_Pa(cal, self.h)
-        self.p_rev = p[::-1].copy()          # increasing
-        self.h_rev = self.h[::-1].copy()
-        self.area = cal.friction_area
-
-    def separation(self, force_N):
-        """Steady-state nominal separation for an applied force, clamped to the film domain."""
-        p = np.minimum(np.maximum(np.asarray(force_N, dtype=float) / self.area, self.p_min), self.p_max)
-        return np.interp(p, self.p_rev, self.h_rev)
-
-
 # --------------------------------------------------------------------------- the simulation
 
 class _Profile:
@@ -390,7 +370,8 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
     steps = np.array([int(round(e.duration_s / dt)) for e in exps])
     n_steps = int(steps.max())
     prof = _Profile(exps, dt, n_steps)
-    film = FilmTable(true_cal, cfg.film_table_nodes)
+    film = model.FilmTable(true_cal, cfg.film_table_nodes)     # h_ss(F_app / A_f): eq. 15/16 inverted
+    area = true_cal.friction_area
     phys = _Physics(true_cal, cfg.stiction_margin)
     gens = _noise_generators(exps, seed)
 
@@ -429,7 +410,7 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
     house = np.array([e.theta0_degC if e.housing0_degC is None else e.housing0_degC for e in exps])
     m_theta, m_oil, m_house = theta.copy(), oil.copy(), house.copy()       # thermistor states
     f_app = np.zeros(n)
-    h = film.separation(f_app)
+    h = film.separation_from_pressure_m(f_app / area)
     if prof.kind == "engagement":
         w = prof.slip.copy()                 # spinning at the initial slip, clutch open
         locked = np.zeros(n, dtype=bool)
@@ -498,7 +479,7 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
         motor_off |= enabled & off_zero & (speed_meas <= 0.0)
         torque_motor = torque_motor * (enabled & ~motor_off)
 
-        h_target = film.separation(f_app)
+        h_target = film.separation_from_pressure_m(f_app / area)
         if k % every == 0:
             r = k // every
             t_rows[r] = t

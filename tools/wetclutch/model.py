@@ -1,7 +1,9 @@
 """Double-precision reference of the control model (DESIGN.md section 2).
 
 Independent of the firmware: NumPy/SciPy in float64, vectorized, with the
-film thickness solved exactly (no table). Equation numbers are the paper's.
+film thickness solved exactly (no table). FilmTable, beside the exact form, is
+the tabulated h_bar(p_c) for many samples (bench simulator, identification),
+tested against it. Equation numbers are the paper's.
 Units: SI, temperatures in degC, slip speed in rpm at the interfaces.
 """
 from __future__ import annotations
@@ -25,6 +27,12 @@ def viscosity_Pa_s(cal: Calibration, theta_degC):
     """mu_v(theta), eq. 2."""
     th = np.asarray(theta_degC, dtype=float)
     return cal.mv1 * np.exp(cal.mv2 * th) + cal.mv3 * np.exp(cal.mv4 * th)
+
+
+def viscosity_slope_Pa_s_per_K(cal: Calibration, theta_degC):
+    """d mu_v / d theta, from eq. 2."""
+    th = np.asarray(theta_degC, dtype=float)
+    return cal.mv1 * cal.mv2 * np.exp(cal.mv2 * th) + cal.mv3 * cal.mv4 * np.exp(cal.mv4 * th)
 
 
 def friction_coefficient(cal: Calibration, speed_m_s, theta_degC):
@@ -95,6 +103,34 @@ def hbar_from_pressure_m(cal: Calibration, pressure_Pa):
     _, _, p_min, p_max = film_domain(cal)
     p = np.clip(np.asarray(pressure_Pa, dtype=float), p_min, p_max)
     return film_thickness_m(cal, separation_from_pressure_m(cal, p))
+
+
+class FilmTable:
+    """The fast form of separation_from_pressure_m and hbar_from_pressure_m for many samples.
+
+    A dense table of the exact closed forms (eq. 9 and 15) at `nodes` separations uniform from the
+    film domain's h_max down to h_min (so p_c increases along it), read by linear interpolation in p_c;
+    the pressure is clamped to the film domain as in hbar_from_pressure_m. No per-sample bisection.
+    Used by the bench simulator (20001 nodes) and the identification (4001 nodes); checked against
+    the exact form in tests/python/test_model_film.py.
+    """
+
+    def __init__(self, cal: Calibration, nodes: int):
+        h_min, h_max, self.pressure_min_Pa, self.pressure_max_Pa = film_domain(cal)
+        self.separation_m = np.linspace(h_max, h_min, nodes)
+        self.pressure_Pa = contact_pressure_Pa(cal, self.separation_m)      # increasing
+        self.hbar_m = film_thickness_m(cal, self.separation_m)
+
+    def _clamped(self, pressure_Pa):
+        return np.clip(np.asarray(pressure_Pa, dtype=float), self.pressure_min_Pa, self.pressure_max_Pa)
+
+    def separation_from_pressure_m(self, pressure_Pa):
+        """Steady-state nominal separation h(p_c) (eq. 15 inverted), clamped to the film domain."""
+        return np.interp(self._clamped(pressure_Pa), self.pressure_Pa, self.separation_m)
+
+    def hbar_from_pressure_m(self, pressure_Pa):
+        """h_bar(p_c) (eq. 9 at the h solving eq. 15), clamped to the film domain."""
+        return np.interp(self._clamped(pressure_Pa), self.pressure_Pa, self.hbar_m)
 
 
 def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N):

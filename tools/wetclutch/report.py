@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import canlog, replay
+from . import canlog, plotting, replay
 from .calibration import Calibration
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15
@@ -138,12 +138,13 @@ def metrics(cal: Calibration, s: Series, stats_frame: dict, stats_timer: dict | 
 
 
 def plots(cal: Calibration, s: Series, m: dict, out_dir: Path) -> list[str]:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    return [_torque_plot(s, m, out_dir), _temperature_plot(s, m, out_dir), _command_plot(cal, s, out_dir),
+            _status_plot(s, out_dir)]
 
-    files = []
-    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+
+def _torque_plot(s: Series, m: dict, out_dir: Path) -> str:
+    """Measured against model torque, and the error (cf. paper Fig. 15)."""
+    fig, (a, b) = plotting.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
     a.plot(s.t_s, s.torque_meas_Nm, label="measured (bench)", lw=1)
     a.plot(s.t_s, s.torque_model_Nm, label="model (TCU ClutchEstimate)", lw=1)
     a.axvline(m["t_contact_s"], color="gray", ls=":", lw=0.8)
@@ -152,59 +153,44 @@ def plots(cal: Calibration, s: Series, m: dict, out_dir: Path) -> list[str]:
         a.axvspan(m["t_lock_s"], float(s.t_s[-1]), color="0.9", lw=0,
                   label="locked: model undefined at zero slip (paper 3.5)")
         b.axvspan(m["t_lock_s"], float(s.t_s[-1]), color="0.9", lw=0)
-    a.set_ylabel("torque [Nm]")
-    a.set_title(f"Engagement at {m['initial_slip_rpm']:.0f} rpm (cf. paper Fig. 15)")
-    a.legend(fontsize=8, loc="lower left")
+    plotting.style(a, ylabel="torque [Nm]", title=f"Engagement at {m['initial_slip_rpm']:.0f} rpm (cf. paper Fig. 15)",
+                   legend={"fontsize": 8, "loc": "lower left"})
     b.plot(s.t_s, s.torque_model_Nm - s.torque_meas_Nm, lw=0.8, color="C3")
-    b.set_ylabel("error [Nm]")
-    b.set_xlabel("time [s]")
-    for ax in (a, b):
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    files.append(_save(fig, out_dir / "torque.png"))
+    plotting.style(b, "time [s]", "error [Nm]")
+    return plotting.save(fig, out_dir / "torque.png")
 
-    fig, ax = plt.subplots(figsize=(8, 4))
+
+def _temperature_plot(s: Series, m: dict, out_dir: Path) -> str:
+    """Thermistor against the observer's estimate (cf. paper Fig. 14)."""
+    fig, ax = plotting.subplots(figsize=(8, 4))
     ax.plot(s.t_s, s.theta_meas_degC, label="measured (thermistor)", lw=1)
     ax.plot(s.t_s, s.theta_est_degC, label="estimated (observer)", lw=1)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("clutch temperature [°C]")
-    ax.set_title(f"Temperature estimate (cf. paper Fig. 14), RMSE {m['theta_rmse_K']:.2f} K")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    files.append(_save(fig, out_dir / "temperature.png"))
+    plotting.style(ax, "time [s]", "clutch temperature [°C]",
+                   f"Temperature estimate (cf. paper Fig. 14), RMSE {m['theta_rmse_K']:.2f} K", legend=True)
+    return plotting.save(fig, out_dir / "temperature.png")
 
-    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+
+def _command_plot(cal: Calibration, s: Series, out_dir: Path) -> str:
+    """The VFS current, and the commanded pressure against the one the bench applied."""
+    fig, (a, b) = plotting.subplots(2, 1, figsize=(8, 5), sharex=True)
     a.plot(s.t_s, s.current_mA, lw=1)
-    a.set_ylabel("VFS current [mA]")
+    plotting.style(a, ylabel="VFS current [mA]")
     b.plot(s.t_s, s.pressure_cmd_kPa, label="commanded (TCU)", lw=1)
     b.plot(s.t_s, (s.load_N + cal.return_spring_force) / cal.piston_area * 1e-3, label="bench actual (F + F_s)/A_p", lw=1)
-    b.set_ylabel("pressure [kPa]")
-    b.set_xlabel("time [s]")
-    b.legend()
-    for ax in (a, b):
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    files.append(_save(fig, out_dir / "command.png"))
+    plotting.style(b, "time [s]", "pressure [kPa]", legend=True)
+    return plotting.save(fig, out_dir / "command.png")
 
-    fig, ax = plt.subplots(figsize=(8, 3.5))
+
+def _status_plot(s: Series, out_dir: Path) -> str:
+    """The VfsCommand status bits over time."""
+    fig, ax = plotting.subplots(figsize=(8, 3.5))
     for i, name in enumerate(replay.STATUS_BITS):
         bit = (s.status >> i) & 1
         ax.fill_between(s.t_s, i, i + 0.8 * bit, step="post", lw=0)
     ax.set_yticks(np.arange(len(replay.STATUS_BITS)) + 0.4)
     ax.set_yticklabels([n.removeprefix("Status") for n in replay.STATUS_BITS], fontsize=7)
-    ax.set_xlabel("time [s]")
-    ax.set_title("VfsCommand status bits")
-    fig.tight_layout()
-    files.append(_save(fig, out_dir / "status.png"))
-    return files
-
-
-def _save(fig, path: Path) -> str:
-    import matplotlib.pyplot as plt
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return str(path)
+    plotting.style(ax, "time [s]", title="VfsCommand status bits", grid=None)
+    return plotting.save(fig, out_dir / "status.png")
 
 
 def summary(m: dict, name: str) -> str:
