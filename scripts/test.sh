@@ -20,6 +20,9 @@ cmake --build --preset host-release
 echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
 bash scripts/check_arm.sh
 
+echo "== Cortex-M4F instruction counts (QEMU -icount; fails above bench/arm_ceilings.txt)"
+bash scripts/bench_arm.sh
+
 echo "== package: find_package(wetclutch) after install, and add_subdirectory(), host and Cortex-M4F"
 bash scripts/check_package.sh
 

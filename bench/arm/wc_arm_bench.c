@@ -1,0 +1,564 @@
+/* Cortex-M4F instruction counts of the library's public functions, under
+ * QEMU (DESIGN.md section 11):
+ *
+ *   qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic -semihosting \
+ *                   -icount shift=8,sleep=off -kernel wc_arm_bench.elf
+ *
+ * With -icount shift=8 one instruction takes 2^8 ns of virtual time and the
+ * SysTick, clocked from the 25 MHz CPU clock (CLKSOURCE = 1), ticks every
+ * 40 ns, so instructions = ticks * 40 / 256, rounded to nearest. SysTick is
+ * reloaded before every window; the window is one indirect call of a small
+ * thunk that calls the measured function with arguments from a context
+ * struct, and the empty thunk's window is subtracted. So a figure is the
+ * call as a caller pays it: argument loads, the call, the result store,
+ * about 5 instructions over the function's own (thunk_expf: push, vldr, mov,
+ * bl, vstr, pop against the empty thunk's bx lr).
+ * A block of 1000 nops must read 1000 (else FAIL). QEMU counts
+ * instructions, not cycles; repeated runs are byte-identical.
+ *
+ * Grid (192 points): slip {-3000, -750, -0.25, 0, 0.25, 50, 750, 3000} rpm x
+ * clutch temperature {10, 40, 80, 120} degC (oil = housing = theta) x torque
+ * request {0, 0.05, 0.3, 0.6, 0.9, 1.1} x the capacity at that point
+ * (|wc_torque| at force_max). Per function: samples, median (the lower
+ * middle sample) and worst. The inverse is split by the status it returns:
+ * below_drag, saturated, and solve (neither: the library's segment search
+ * and Newton steps, the naive baseline's bisection). The naive baseline
+ * (wc_arm_naive.c: no h_bar table, eq. 15 solved by bisection with
+ * erfcf/expf at every torque evaluation) runs on the same points and must
+ * agree with wc_inverse within NAIVE_AGREEMENT_mN; the ratio naive /
+ * wc_inverse of the solve rows' median and worst is printed.
+ *
+ * Output lines (parsed by scripts/bench_arm.sh):
+ *   EMPTY <instructions>        window overhead, subtracted from every figure
+ *   NOP <instructions>          1000 nops (must read 1000)
+ *   ROW <name> <samples> <median> <worst>
+ *   NAIVE ...                   naive-vs-library force check and ratio
+ *   RESULT OK | RESULT FAIL <why>
+ * main returns 0 only with RESULT OK (startup.S turns it into QEMU's exit code).
+ */
+#include <math.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <wetclutch/wetclutch.h>
+#include <wetclutch_can/wc_can_signals.h>
+#include <wetclutch_can/wc_loop.h>
+
+#include "wc_arm_calibration.h"
+#include "wc_arm_io.h"
+#include "wc_arm_naive.h"
+
+#ifndef WC_ARM_BENCH_LEVEL
+#define WC_ARM_BENCH_LEVEL unknown
+#endif
+#define WC_STR_(x) #x
+#define WC_STR(x) WC_STR_(x)
+
+#define WC_ARRAY_LENGTH(a) (sizeof(a) / sizeof((a)[0]))
+
+/* SysTick (ARMv7-M architecture reference, B3.3). */
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_CSR_ENABLE 0x1u
+#define SYST_CSR_CLKSOURCE_CPU 0x4u  /* the processor clock: 25 MHz on mps2-an386 */
+#define SYST_MAX 0x00FFFFFFu         /* 24-bit down-counter */
+
+#define NS_PER_TICK 40u              /* 25 MHz */
+#define ICOUNT_SHIFT 8u              /* -icount shift=8: 256 ns per instruction */
+/* A window must stay well inside one SysTick period (2^24 ticks = 2.6 M instructions). */
+#define WINDOW_MAX_INSTRUCTIONS 2000000u
+
+#define NOP_BLOCK 1000u
+#define WARMUP_STEPS 3u
+
+/* The TorqueRequest signal's DBC range is 0..2000 Nm (hil/wetclutch.dbc):
+ * the loop's request is capped there so that every frame is plausible. */
+#define LOOP_REQUEST_MAX_Nm 2000.0f
+/* The naive inverse must agree with wc_inverse within this: the table's
+ * 3.9e-5 relative error and both solvers' 0.01 N tolerances stay far below. */
+#define NAIVE_AGREEMENT_mN 5000u
+
+static const float slip_grid_rpm[] = {-3000.0f, -750.0f, -0.25f, 0.0f, 0.25f, 50.0f, 750.0f, 3000.0f};
+static const float theta_grid_degC[] = {10.0f, 40.0f, 80.0f, 120.0f};
+static const float request_grid[] = {0.0f, 0.05f, 0.3f, 0.6f, 0.9f, 1.1f};
+
+#define GRID_POINTS (WC_ARRAY_LENGTH(slip_grid_rpm) * WC_ARRAY_LENGTH(theta_grid_degC) * WC_ARRAY_LENGTH(request_grid))
+
+typedef enum {
+    ROW_CLUTCH_STEP = 0,
+    ROW_INVERSE_SOLVE,
+    ROW_INVERSE_BELOW_DRAG,
+    ROW_INVERSE_SATURATED,
+    ROW_NAIVE_SOLVE,
+    ROW_NAIVE_BELOW_DRAG,
+    ROW_NAIVE_SATURATED,
+    ROW_TORQUE,
+    ROW_THERMAL_STEP,
+    ROW_FRICTION_VISCOSITY,
+    ROW_EXPF,
+    ROW_LOOP_STEP,
+    ROW_DECODE_CLUTCH_SENSORS,
+    ROW_DECODE_TORQUE_REQUEST,
+    ROW_ENCODE_VFS_COMMAND,
+    ROW_ENCODE_CLUTCH_ESTIMATE,
+    ROW_CRC8,
+    ROWS
+} row_t;
+
+/* Names as in bench/arm_ceilings.txt (no spaces). */
+static const char *const row_name[ROWS] = {
+    [ROW_CLUTCH_STEP] = "wc_clutch_step",
+    [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
+    [ROW_INVERSE_BELOW_DRAG] = "wc_inverse:below_drag",
+    [ROW_INVERSE_SATURATED] = "wc_inverse:saturated",
+    [ROW_NAIVE_SOLVE] = "naive_inverse:solve",
+    [ROW_NAIVE_BELOW_DRAG] = "naive_inverse:below_drag",
+    [ROW_NAIVE_SATURATED] = "naive_inverse:saturated",
+    [ROW_TORQUE] = "wc_torque",
+    [ROW_THERMAL_STEP] = "wc_thermal_step",
+    [ROW_FRICTION_VISCOSITY] = "wc_friction_coefficient+wc_viscosity_Pa_s",
+    [ROW_EXPF] = "expf",
+    [ROW_LOOP_STEP] = "wc_loop_step",
+    [ROW_DECODE_CLUTCH_SENSORS] = "wc_can_decode_clutch_sensors",
+    [ROW_DECODE_TORQUE_REQUEST] = "wc_can_decode_torque_request",
+    [ROW_ENCODE_VFS_COMMAND] = "wc_can_encode_vfs_command",
+    [ROW_ENCODE_CLUTCH_ESTIMATE] = "wc_can_encode_clutch_estimate",
+    [ROW_CRC8] = "wc_e2e_crc8_j1850:8B",
+};
+
+#define SAMPLES_PER_ROW (2u * GRID_POINTS)  /* expf: two arguments per point */
+static uint32_t samples[ROWS][SAMPLES_PER_ROW];
+static uint32_t sample_count[ROWS];
+
+/* Everything a thunk reads or writes: arguments in, results out. */
+typedef struct {
+    const wc_model_t *model;
+    const wc_calibration_t *cal;
+    float slip_rad_s;
+    float theta_degC;
+    float request_Nm;
+    float force_N;
+    float power_W;
+    float speed_m_s;
+    float exp_argument;
+    float theta_state_degC;
+    float mu_f;
+    float mu_v_Pa_s;
+    float exp_value;
+    wc_status_t status;
+    wc_inverse_t inverse;
+    wc_torque_t torque;
+    wc_clutch_t *clutch;
+    wc_step_input_t step_in;
+    wc_step_output_t step_out;
+    wc_loop_t *loop;
+    wc_can_frame_t tx[WC_LOOP_TX_FRAMES];
+    uint32_t tx_frames;
+    uint8_t sensors_frame[8];
+    uint8_t request_frame[8];
+    uint8_t out_frame[8];
+    wc_can_clutch_sensors_phys_t sensors;
+    wc_can_torque_request_phys_t request;
+    wc_can_vfs_command_phys_t vfs;
+    wc_can_clutch_estimate_phys_t estimate;
+    wc_can_result_t can_result;
+    uint8_t crc;
+} bench_ctx_t;
+
+typedef void (*thunk_t)(void *ctx);
+
+/* noipa: never inlined, cloned or specialised, so each window holds exactly
+ * one indirect call and the measured code cannot be scheduled across the
+ * SysTick reads. */
+#define THUNK(name) __attribute__((noipa)) static void name(void *ctx)
+
+THUNK(thunk_empty) { (void)ctx; }
+THUNK(thunk_nops)
+{
+    (void)ctx;
+    __asm__ volatile(".rept 1000\n\tnop\n\t.endr" ::: "memory");
+}
+THUNK(thunk_clutch_step)
+{
+    bench_ctx_t *c = ctx;
+    c->status = wc_clutch_step(c->clutch, &c->step_in, &c->step_out);
+}
+THUNK(thunk_inverse)
+{
+    bench_ctx_t *c = ctx;
+    c->status = wc_inverse(c->model, c->slip_rad_s, c->theta_degC, c->request_Nm, &c->inverse);
+}
+THUNK(thunk_naive_inverse)
+{
+    bench_ctx_t *c = ctx;
+    c->status = wc_arm_naive_inverse(c->model, c->slip_rad_s, c->theta_degC, c->request_Nm, &c->inverse);
+}
+THUNK(thunk_torque)
+{
+    bench_ctx_t *c = ctx;
+    c->status = wc_torque(c->model, c->slip_rad_s, c->theta_degC, c->force_N, &c->torque);
+}
+THUNK(thunk_thermal_step)
+{
+    bench_ctx_t *c = ctx;
+    c->status = wc_thermal_step(c->model, &c->theta_state_degC, c->power_W, c->theta_degC, c->theta_degC);
+}
+THUNK(thunk_friction_viscosity)
+{
+    bench_ctx_t *c = ctx;
+    c->mu_f = wc_friction_coefficient(c->cal, c->speed_m_s, c->theta_degC);
+    c->mu_v_Pa_s = wc_viscosity_Pa_s(c->cal, c->theta_degC);
+}
+THUNK(thunk_expf)
+{
+    bench_ctx_t *c = ctx;
+    c->exp_value = expf(c->exp_argument);
+}
+THUNK(thunk_loop_step)
+{
+    bench_ctx_t *c = ctx;
+    c->tx_frames = wc_loop_step(c->loop, c->tx);
+}
+THUNK(thunk_decode_clutch_sensors)
+{
+    bench_ctx_t *c = ctx;
+    c->can_result = wc_can_decode_clutch_sensors(&c->sensors, c->sensors_frame, sizeof c->sensors_frame);
+}
+THUNK(thunk_decode_torque_request)
+{
+    bench_ctx_t *c = ctx;
+    c->can_result = wc_can_decode_torque_request(&c->request, c->request_frame, sizeof c->request_frame);
+}
+THUNK(thunk_encode_vfs_command)
+{
+    bench_ctx_t *c = ctx;
+    c->can_result = wc_can_encode_vfs_command(c->out_frame, &c->vfs, sizeof c->out_frame);
+}
+THUNK(thunk_encode_clutch_estimate)
+{
+    bench_ctx_t *c = ctx;
+    c->can_result = wc_can_encode_clutch_estimate(c->out_frame, &c->estimate, sizeof c->out_frame);
+}
+THUNK(thunk_crc8)
+{
+    bench_ctx_t *c = ctx;
+    c->crc = wc_e2e_crc8_j1850(c->sensors_frame, sizeof c->sensors_frame);
+}
+
+/* SysTick ticks over one call of thunk(ctx). */
+__attribute__((noipa)) static uint32_t window_ticks(thunk_t thunk, void *ctx)
+{
+    SYST_CSR = 0u;
+    SYST_RVR = SYST_MAX;
+    SYST_CVR = 0u;  /* any write clears the counter */
+    SYST_CSR = SYST_CSR_ENABLE | SYST_CSR_CLKSOURCE_CPU;
+    const uint32_t start = SYST_CVR;
+    thunk(ctx);
+    const uint32_t end = SYST_CVR;
+    return (start - end) & SYST_MAX;
+}
+
+static uint32_t window_instructions(thunk_t thunk, void *ctx)
+{
+    const uint32_t ticks = window_ticks(thunk, ctx);
+    return (ticks * NS_PER_TICK + (1u << (ICOUNT_SHIFT - 1u))) >> ICOUNT_SHIFT;
+}
+
+static uint32_t empty_window;
+static bool failed;
+static const char *fail_reason = "";
+
+static void fail(const char *reason)
+{
+    if (!failed) {
+        failed = true;
+        fail_reason = reason;
+    }
+    wc_arm_puts("FAIL ");
+    wc_arm_puts(reason);
+    wc_arm_puts("\n");
+}
+
+static uint32_t measure(thunk_t thunk, bench_ctx_t *ctx)
+{
+    const uint32_t raw = window_instructions(thunk, ctx);
+    if ((raw < empty_window) || (raw > WINDOW_MAX_INSTRUCTIONS)) {
+        fail("window outside [empty window, WINDOW_MAX_INSTRUCTIONS]");
+        return 0u;
+    }
+    return raw - empty_window;
+}
+
+static void record(row_t row, uint32_t instructions)
+{
+    if (sample_count[row] < SAMPLES_PER_ROW) {
+        samples[row][sample_count[row]] = instructions;
+        sample_count[row]++;
+    }
+}
+
+static void sort(uint32_t *v, uint32_t n)
+{
+    for (uint32_t i = 1u; i < n; ++i) {
+        const uint32_t x = v[i];
+        uint32_t j = i;
+        while ((j > 0u) && (v[j - 1u] > x)) {
+            v[j] = v[j - 1u];
+            j--;
+        }
+        v[j] = x;
+    }
+}
+
+/* Inverse rows by the status the call returned. */
+static row_t inverse_row(wc_status_t status, row_t solve)
+{
+    if ((status & WC_STATUS_BELOW_DRAG) != 0u) { return (row_t)(solve + 1); }
+    if ((status & WC_STATUS_SATURATED) != 0u) { return (row_t)(solve + 2); }
+    return solve;
+}
+
+static void put_point(float slip_rpm, float theta_degC, float fraction)
+{
+    wc_arm_puts(" at slip ");
+    wc_arm_put_i32((int32_t)lroundf(slip_rpm * 100.0f));
+    wc_arm_puts("e-2 rpm, theta ");
+    wc_arm_put_i32((int32_t)lroundf(theta_degC));
+    wc_arm_puts(" degC, request ");
+    wc_arm_put_u32((uint32_t)lroundf(fraction * 100.0f));
+    wc_arm_puts("% of capacity");
+}
+
+static wc_model_t model;
+static wc_clutch_t clutch;
+static wc_loop_t loop;
+static bench_ctx_t ctx;
+
+/* One ClutchSensors and one TorqueRequest frame with alive counter `alive`,
+ * queued in the loop. */
+static void queue_frames(float slip_rpm, float theta_degC, float request_Nm, uint8_t alive)
+{
+    const wc_can_clutch_sensors_phys_t sensors = {slip_rpm, theta_degC, theta_degC, alive};
+    const wc_can_torque_request_phys_t request = {fminf(request_Nm, LOOP_REQUEST_MAX_Nm),
+                                                  WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE, alive};
+    if ((wc_can_encode_clutch_sensors(ctx.sensors_frame, &sensors, sizeof ctx.sensors_frame) != WC_CAN_OK) ||
+        (wc_can_encode_torque_request(ctx.request_frame, &request, sizeof ctx.request_frame) != WC_CAN_OK)) {
+        fail("encoding the loop's input frames");
+    }
+    wc_can_frame_t frame = {WC_CAN_CLUTCH_SENSORS_FRAME_ID, 8u, 0u, {0u}};
+    for (uint32_t i = 0u; i < 8u; ++i) { frame.data[i] = ctx.sensors_frame[i]; }
+    (void)wc_loop_receive(&loop, &frame);
+    frame.id = WC_CAN_TORQUE_REQUEST_FRAME_ID;
+    for (uint32_t i = 0u; i < 8u; ++i) { frame.data[i] = ctx.request_frame[i]; }
+    (void)wc_loop_receive(&loop, &frame);
+}
+
+/* Where the naive inverse differs most from wc_inverse. */
+typedef struct {
+    float diff_N;
+    float force_N;  /* wc_inverse's */
+    float slip_rpm;
+    float theta_degC;
+    float fraction;
+} worst_diff_t;
+
+static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_diff_t *worst)
+{
+    const float slip_rad_s = slip_rpm * WC_RAD_S_PER_RPM;
+    ctx.model = &model;
+    ctx.cal = model.cal;
+    ctx.slip_rad_s = slip_rad_s;
+    ctx.theta_degC = theta_degC;
+
+    wc_torque_t capacity;
+    if (wc_torque(&model, slip_rad_s, theta_degC, model.force_max_N, &capacity) != WC_STATUS_OK) {
+        fail("capacity: wc_torque rejected a grid point");
+    }
+    const float request_Nm = fraction * fabsf(capacity.torque_Nm);
+    ctx.request_Nm = request_Nm;
+
+    /* wc_inverse, then the naive baseline at the same point. */
+    const uint32_t inverse_count = measure(thunk_inverse, &ctx);
+    const wc_status_t inverse_status = ctx.status;
+    const wc_inverse_t inverse = ctx.inverse;
+    if ((inverse_status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_inverse rejected a grid point"); }
+    record(inverse_row(inverse_status, ROW_INVERSE_SOLVE), inverse_count);
+
+    const uint32_t naive_count = measure(thunk_naive_inverse, &ctx);
+    const row_t naive_row = inverse_row(ctx.status, ROW_NAIVE_SOLVE);
+    record(naive_row, naive_count);
+    if ((naive_row - ROW_NAIVE_SOLVE) != (inverse_row(inverse_status, ROW_INVERSE_SOLVE) - ROW_INVERSE_SOLVE)) {
+        wc_arm_puts("NAIVE case differs from wc_inverse");
+        put_point(slip_rpm, theta_degC, fraction);
+        wc_arm_puts("\n");
+        fail("naive inverse: below-drag/saturated case differs from wc_inverse");
+    }
+    const float diff_N = fabsf(ctx.inverse.force_N - inverse.force_N);
+    if (diff_N > worst->diff_N) {
+        *worst = (worst_diff_t){diff_N, inverse.force_N, slip_rpm, theta_degC, fraction};
+    }
+
+    /* wc_torque at the force the inverse found. */
+    ctx.force_N = inverse.force_N;
+    record(ROW_TORQUE, measure(thunk_torque, &ctx));
+    const float torque_Nm = ctx.torque.torque_Nm;
+
+    /* Observer step with the heat input of that torque. */
+    ctx.theta_state_degC = theta_degC;
+    ctx.power_W = fabsf(torque_Nm * slip_rad_s);
+    record(ROW_THERMAL_STEP, measure(thunk_thermal_step, &ctx));
+
+    ctx.speed_m_s = model.effective_radius_m * fabsf(slip_rad_s);
+    record(ROW_FRICTION_VISCOSITY, measure(thunk_friction_viscosity, &ctx));
+
+    /* expf at the model's typical arguments: the two viscosity exponents of eq. 2. */
+    ctx.exp_argument = model.cal->viscosity_b1_per_K * theta_degC;
+    record(ROW_EXPF, measure(thunk_expf, &ctx));
+    ctx.exp_argument = model.cal->viscosity_b2_per_K * theta_degC;
+    record(ROW_EXPF, measure(thunk_expf, &ctx));
+
+    /* wc_clutch_step: a fresh clutch at theta, the 4th step measured. */
+    if (wc_clutch_init(&clutch, model.cal, theta_degC) != WC_CAL_OK) { fail("wc_clutch_init"); }
+    ctx.clutch = &clutch;
+    ctx.step_in = (wc_step_input_t){slip_rad_s, theta_degC, theta_degC, request_Nm, WC_MODE_TORQUE, {false, 0.0f, 0.0f}};
+    for (uint32_t k = 0u; k < WARMUP_STEPS; ++k) { thunk_clutch_step(&ctx); }
+    record(ROW_CLUTCH_STEP, measure(thunk_clutch_step, &ctx));
+    if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step rejected a grid point"); }
+    const wc_step_output_t step = ctx.step_out;
+
+    /* wc_loop_step: both input frames queued every period, the 4th step measured. */
+    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    if (wc_loop_init(&loop, model.cal, &config, theta_degC) != WC_CAL_OK) { fail("wc_loop_init"); }
+    ctx.loop = &loop;
+    for (uint8_t k = 0u; k <= WARMUP_STEPS; ++k) {
+        queue_frames(slip_rpm, theta_degC, request_Nm, k);
+        if (k < WARMUP_STEPS) {
+            thunk_loop_step(&ctx);
+        } else {
+            record(ROW_LOOP_STEP, measure(thunk_loop_step, &ctx));
+        }
+    }
+    const uint32_t frames_in = 2u * (WARMUP_STEPS + 1u);
+    if ((ctx.tx_frames != WC_LOOP_TX_FRAMES) || (loop.counters.frames_used != frames_in) ||
+        (loop.counters.safe_steps != 0u)) {
+        wc_arm_puts("LOOP frames used ");
+        wc_arm_put_u32(loop.counters.frames_used);
+        wc_arm_puts(", safe steps ");
+        wc_arm_put_u32(loop.counters.safe_steps);
+        put_point(slip_rpm, theta_degC, fraction);
+        wc_arm_puts("\n");
+        fail("wc_loop_step: an input frame was rejected or the loop was in the safe state");
+    }
+
+    /* The frame codec and the CRC, on the last period's frames. */
+    record(ROW_DECODE_CLUTCH_SENSORS, measure(thunk_decode_clutch_sensors, &ctx));
+    if (ctx.can_result != WC_CAN_OK) { fail("wc_can_decode_clutch_sensors"); }
+    record(ROW_DECODE_TORQUE_REQUEST, measure(thunk_decode_torque_request, &ctx));
+    if (ctx.can_result != WC_CAN_OK) { fail("wc_can_decode_torque_request"); }
+    ctx.vfs = (wc_can_vfs_command_phys_t){step.current_mA, 0.001f * step.pressure_command_Pa, 0u, WARMUP_STEPS};
+    record(ROW_ENCODE_VFS_COMMAND, measure(thunk_encode_vfs_command, &ctx));
+    ctx.estimate = (wc_can_clutch_estimate_phys_t){step.theta_degC, step.model.torque_Nm, step.model.mu_f,
+                                                   1.0e6f * step.model.hbar_m};
+    record(ROW_ENCODE_CLUTCH_ESTIMATE, measure(thunk_encode_clutch_estimate, &ctx));
+    record(ROW_CRC8, measure(thunk_crc8, &ctx));
+}
+
+static uint32_t median_of(row_t row)
+{
+    return (sample_count[row] == 0u) ? 0u : samples[row][(sample_count[row] - 1u) / 2u];
+}
+
+static uint32_t worst_of(row_t row)
+{
+    return (sample_count[row] == 0u) ? 0u : samples[row][sample_count[row] - 1u];
+}
+
+/* naive / library, in hundredths, rounded. */
+static void put_ratio(uint32_t naive, uint32_t library)
+{
+    if (library == 0u) {
+        wc_arm_puts("n/a");
+        return;
+    }
+    const uint64_t hundredths = ((uint64_t)naive * 100u + library / 2u) / library;
+    wc_arm_put_fixed((uint32_t)hundredths, 2u);
+}
+
+int main(void)
+{
+    wc_arm_puts("wc_arm_bench: Cortex-M4F instruction counts (QEMU mps2-an386, -icount shift=8), level -"
+                WC_STR(WC_ARM_BENCH_LEVEL) "\n");
+
+    /* Calibration: the empty window (subtracted from every figure; it must be
+     * the same every time), then 1000 nops. */
+    empty_window = window_instructions(thunk_empty, &ctx);
+    for (uint32_t i = 0u; i < 8u; ++i) {
+        if (window_instructions(thunk_empty, &ctx) != empty_window) { fail("the empty window is not constant"); }
+    }
+    wc_arm_puts("EMPTY ");
+    wc_arm_put_u32(empty_window);
+    wc_arm_puts("\n");
+    const uint32_t nops = measure(thunk_nops, &ctx);
+    wc_arm_puts("NOP ");
+    wc_arm_put_u32(nops);
+    wc_arm_puts(" (a block of 1000 nops; must read 1000 +- 1)\n");
+    if ((nops + 1u < NOP_BLOCK) || (nops > NOP_BLOCK + 1u)) { fail("1000 nops do not read 1000"); }
+
+    if (wc_model_init(&model, wc_arm_calibration) != WC_CAL_OK) {
+        fail("wc_model_init(table1)");
+    } else {
+        worst_diff_t worst = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+        for (uint32_t s = 0u; s < WC_ARRAY_LENGTH(slip_grid_rpm); ++s) {
+            for (uint32_t t = 0u; t < WC_ARRAY_LENGTH(theta_grid_degC); ++t) {
+                for (uint32_t r = 0u; r < WC_ARRAY_LENGTH(request_grid); ++r) {
+                    bench_point(slip_grid_rpm[s], theta_grid_degC[t], request_grid[r], &worst);
+                }
+            }
+        }
+
+        wc_arm_puts("GRID ");
+        wc_arm_put_u32((uint32_t)GRID_POINTS);
+        wc_arm_puts(" points: slip 8 x theta 4 x request 6\n");
+        for (uint32_t row = 0u; row < (uint32_t)ROWS; ++row) {
+            sort(samples[row], sample_count[row]);
+            wc_arm_puts("ROW ");
+            wc_arm_puts(row_name[row]);
+            wc_arm_puts(" ");
+            wc_arm_put_u32(sample_count[row]);
+            wc_arm_puts(" ");
+            wc_arm_put_u32(median_of((row_t)row));
+            wc_arm_puts(" ");
+            wc_arm_put_u32(worst_of((row_t)row));
+            wc_arm_puts("\n");
+            if (sample_count[row] == 0u) { fail("a row has no samples"); }
+        }
+
+        const uint32_t worst_diff_mN = (uint32_t)lroundf(worst.diff_N * 1000.0f);
+        wc_arm_puts("NAIVE force_diff_worst_N ");
+        wc_arm_put_fixed(worst_diff_mN, 3u);
+        wc_arm_puts(" (|F_naive - F_wc_inverse| over the grid, limit ");
+        wc_arm_put_fixed(NAIVE_AGREEMENT_mN, 3u);
+        wc_arm_puts(" N; worst at F = ");
+        wc_arm_put_u32((uint32_t)lroundf(worst.force_N));
+        wc_arm_puts(" N");
+        put_point(worst.slip_rpm, worst.theta_degC, worst.fraction);
+        wc_arm_puts(")\n");
+        if (worst_diff_mN > NAIVE_AGREEMENT_mN) { fail("the naive inverse disagrees with wc_inverse"); }
+        wc_arm_puts("NAIVE ratio_solve_median ");
+        put_ratio(median_of(ROW_NAIVE_SOLVE), median_of(ROW_INVERSE_SOLVE));
+        wc_arm_puts(" ratio_solve_worst ");
+        put_ratio(worst_of(ROW_NAIVE_SOLVE), worst_of(ROW_INVERSE_SOLVE));
+        wc_arm_puts("\n");
+    }
+
+    if (failed) {
+        wc_arm_puts("RESULT FAIL ");
+        wc_arm_puts(fail_reason);
+        wc_arm_puts("\n");
+        return 1;
+    }
+    wc_arm_puts("RESULT OK\n");
+    return 0;
+}
