@@ -316,7 +316,7 @@ arm-none-eabi-gcc $gcc_version, preset $preset: -mcpu=cortex-m4 -mthumb -mfloat-
 | flash, library + LUT | $flash_total B ($(awk -v b="$flash_total" 'BEGIN { printf "%.2f", b / 1024 }') KiB) | $(goal "$flash_total" 8192) |
 | static RAM, library + LUT | $ram_static B | state lives in the caller's wc_clutch_t |
 | CAN layer (libwetclutch_can.a: codec, E2E, frame loop) text/data/bss | $can_text / $can_data / $can_bss B | optional; every frame's pack and unpack |
-| flash of a linked firmware (clutch init+step, loop init+step), minus an empty one | $linked_flash B | gc-sections; includes newlib expf, roundf |
+| flash of a linked firmware (clutch init+step, loop init+step), minus an empty one | $linked_flash B | gc-sections; includes newlib expf (used at init only) and memset |
 | state per clutch, sizeof(wc_clutch_t) | $state_bytes B (of which wc_model_t $model_bytes B) | $(goal "$state_bytes" 64) |
 | worst stack, public entry point | $worst_public B, $worst_public_name | $(goal "$worst_public" 256) |
 | stack of wc_clutch_step | $step_stack B | |

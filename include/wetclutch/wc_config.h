@@ -78,6 +78,17 @@
 #endif
 #endif
 
+/* A small helper on a hot path: always inlined when optimising for speed
+ * (-O2: the frame codec folds each signal's constants, bench/arm), left to
+ * the compiler when optimising for size (-Os keeps one copy). */
+#ifndef WC_INLINE_HOT
+#if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define WC_INLINE_HOT static inline __attribute__((always_inline))
+#else
+#define WC_INLINE_HOT static inline
+#endif
+#endif
+
 /* Longest film table the library accepts (bounds the lookup's search). */
 #ifndef WC_FILM_MAX_NODES
 #define WC_FILM_MAX_NODES 1024u

@@ -3,7 +3,9 @@
  * hil/wetclutch.dbc (src/can/generated/wc_can_signals.c). */
 #include "wetclutch_can/wc_can_scaling.h"
 
-#include <math.h>
+#include <stddef.h>
+
+#include "wc_can_scaling_inline.h"
 
 /* ---- results ------------------------------------------------------------- */
 
@@ -14,22 +16,10 @@ bool wc_can_is_error(wc_can_result_t result)
 
 wc_can_result_t wc_can_worst(wc_can_result_t a, wc_can_result_t b)
 {
-    return (b > a) ? b : a;
+    return wc_can_worst_of(a, b);
 }
 
 /* ---- one signal ---------------------------------------------------------- */
-
-/* roundf for |x| <= 2^24: to nearest, ties away from zero. The conversion to
- * int truncates toward zero and x - t is exact, so this equals roundf
- * bit for bit, in a handful of instructions instead of a newlib call. */
-static float round_half_away(float x)
-{
-    const float t = (float)(int32_t)x;
-    const float r = x - t;
-    if (r >= 0.5f) { return t + 1.0f; }
-    if (r <= -0.5f) { return t - 1.0f; }
-    return t;
-}
 
 wc_can_result_t wc_can_phys_to_raw(const wc_can_signal_t *sig, float value,
                                    int32_t *raw)
@@ -37,28 +27,7 @@ wc_can_result_t wc_can_phys_to_raw(const wc_can_signal_t *sig, float value,
     if ((sig == NULL) || (raw == NULL)) {
         return WC_CAN_ERR_SIZE;
     }
-    if (isnan(value)) {
-        *raw = sig->raw_nan;
-        return WC_CAN_ERR_NAN;
-    }
-    /* Every raw limit is below 2^24 in magnitude, so it is exact in float and
-     * the comparisons below decide saturation exactly; +-inf saturates. A
-     * value beyond [raw_min - 1, raw_max + 1] saturates before rounding (it
-     * would after rounding too), which keeps round_half_away in its range. */
-    const float unrounded = (value - sig->offset) / sig->scale;
-    const float lowest = (float)sig->raw_min - 1.0f;
-    const float highest = (float)sig->raw_max + 1.0f;
-    const float steps = round_half_away((unrounded < lowest) ? lowest : ((unrounded > highest) ? highest : unrounded));
-    if (steps < (float)sig->raw_min) {
-        *raw = sig->raw_min;
-        return WC_CAN_SATURATED;
-    }
-    if (steps > (float)sig->raw_max) {
-        *raw = sig->raw_max;
-        return WC_CAN_SATURATED;
-    }
-    *raw = (int32_t)steps;
-    return WC_CAN_OK;
+    return wc_can_scale_to_raw(sig, value, raw);
 }
 
 wc_can_result_t wc_can_raw_to_phys(const wc_can_signal_t *sig, int32_t raw,
@@ -67,13 +36,5 @@ wc_can_result_t wc_can_raw_to_phys(const wc_can_signal_t *sig, int32_t raw,
     if ((sig == NULL) || (value == NULL)) {
         return WC_CAN_ERR_SIZE;
     }
-    if (sig->has_sna && (raw == sig->raw_sna)) {
-        *value = NAN;
-        return WC_CAN_ERR_SNA;
-    }
-    *value = ((float)raw * sig->scale) + sig->offset;
-    if ((raw < sig->raw_min) || (raw > sig->raw_max)) {
-        return WC_CAN_ERR_RANGE;
-    }
-    return WC_CAN_OK;
+    return wc_can_scale_to_phys(sig, raw, value);
 }

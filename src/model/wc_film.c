@@ -3,7 +3,6 @@
 #include <stddef.h>
 
 #include "wetclutch/wc_config.h"
-#include "wc_operating_point.h"
 
 float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
 {
@@ -35,17 +34,3 @@ float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
            h01 * table->hbar_m[hi] + h11 * width_Pa * table->slope_m_per_Pa[hi];
 }
 
-void wc_film_segment_cubic(const wc_film_table_t *table, uint32_t k, float coefficient[4])
-{
-    /* The Hermite basis of wc_film_hbar_m expanded in powers of t, with the
-     * slopes scaled to the segment: m = (p_k+1 - p_k) dh_bar/dp_c. */
-    const float width_Pa = table->pressure_Pa[k + 1u] - table->pressure_Pa[k];
-    const float h0 = table->hbar_m[k];
-    const float h1 = table->hbar_m[k + 1u];
-    const float m0 = width_Pa * table->slope_m_per_Pa[k];
-    const float m1 = width_Pa * table->slope_m_per_Pa[k + 1u];
-    coefficient[0] = h0;
-    coefficient[1] = m0;
-    coefficient[2] = 3.0f * (h1 - h0) - 2.0f * m0 - m1;
-    coefficient[3] = 2.0f * (h0 - h1) + m0 + m1;
-}

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "wetclutch/wc_config.h"
+#include "wc_internal.h"
 
 /* Speed / v_s beyond which the Stribeck term cannot change mu_f (see below). */
 #define WC_STRIBECK_NEGLIGIBLE 30.0f
@@ -14,9 +14,9 @@ float wc_friction_coefficient(const wc_calibration_t *cal, float speed_m_s, floa
     /* eq. 18: Stribeck exponential in speed times a linear temperature term.
      * Above 30 Stribeck speeds e^-x < 1e-13: (mu2 - mu1) e^-x is below half an
      * ulp of mu1 unless |mu2 - mu1| > 6e5 mu1, so the sum is mu1 exactly and
-     * expf (about 80 instructions on a Cortex-M4F) is skipped. */
+     * the exponential is skipped. */
     const float x = fabsf(speed_m_s) / cal->stribeck_speed_m_s;
-    const float decay = (x < WC_STRIBECK_NEGLIGIBLE) ? expf(-x) : 0.0f;
+    const float decay = (x < WC_STRIBECK_NEGLIGIBLE) ? wc_exp(-x) : 0.0f;
     const float stribeck = cal->mu1 + (cal->mu2 - cal->mu1) * decay;
     return stribeck * (1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K);
 }

@@ -53,19 +53,27 @@ typedef struct {
 static wc_segment_t find_segment(const wc_film_table_t *film, float area_m2, const wc_torque_point_t *point,
                                  float request_Nm, float excess_first, float excess_last)
 {
-    wc_segment_t s = { 0u, excess_first, excess_last };
+    /* Locals, not the struct, in the loop: the compiler keeps them in registers. */
+    const float *pressure_Pa = film->pressure_Pa;
+    const float *hbar_m = film->hbar_m;
+    const float c_per_Pa = point->coulomb_Nm_per_N * area_m2;  /* T per unit of p_c */
+    const float v = point->viscous_Nm_m;
+    uint32_t lo = 0u;
     uint32_t hi = film->length - 1u;
-    for (uint32_t guard = 0u; (guard < 32u) && (hi - s.node > 1u); ++guard) {
-        const uint32_t mid = s.node + (hi - s.node) / 2u;
-        const float e = excess(point, request_Nm, film->pressure_Pa[mid] * area_m2, film->hbar_m[mid]);
+    float excess_lo = excess_first;
+    float excess_hi = excess_last;
+    for (uint32_t guard = 0u; (guard < 32u) && (hi - lo > 1u); ++guard) {
+        const uint32_t mid = (lo + hi) / 2u;  /* lengths are at most WC_FILM_MAX_NODES: no overflow */
+        const float e = hbar_m[mid] * (request_Nm - c_per_Pa * pressure_Pa[mid]) - v;  /* excess() */
         if (e >= 0.0f) {
-            s.node = mid;
-            s.excess_lo = e;
+            lo = mid;
+            excess_lo = e;
         } else {
             hi = mid;
-            s.excess_hi = e;
+            excess_hi = e;
         }
     }
+    const wc_segment_t s = { lo, excess_lo, excess_hi };
     return s;
 }
 
@@ -79,10 +87,21 @@ static float solve_segment(const wc_film_table_t *film, float area_m2, const wc_
     const float width_N = (film->pressure_Pa[s->node + 1u] - film->pressure_Pa[s->node]) * area_m2;
     const float c = point->coulomb_Nm_per_N;
     const float v = point->viscous_Nm_m;
-    /* Start: T linear between the nodes, T_req - T_k = e_lo / h_k, T_k+1 - T_req = -e_hi / h_k+1. */
-    const float a = s->excess_lo * film->hbar_m[s->node + 1u];
-    const float b = -s->excess_hi * film->hbar_m[s->node];
-    float t = a / (a + b);  /* a >= 0, b > 0 */
+    /* Start: the cubic Hermite of t(T) through both nodes, with the slopes
+     * dt/dT = 1 / (dT/dt) there (dT/dt = c W - v h' / h^2, positive). With
+     * T_req - T_k = e_lo / h_k and T_k+1 - T_req = -e_hi / h_k+1: */
+    const float h0 = film->hbar_m[s->node];
+    const float h1 = film->hbar_m[s->node + 1u];
+    const float below_Nm = s->excess_lo / h0;
+    const float span_Nm = below_Nm - s->excess_hi / h1;                 /* T_k+1 - T_k > 0 */
+    const float u = below_Nm / span_Nm;
+    const float slope0 = c * width_N - v * cubic[1] / (h0 * h0);
+    const float m1 = (film->pressure_Pa[s->node + 1u] - film->pressure_Pa[s->node]) * film->slope_m_per_Pa[s->node + 1u];
+    const float slope1 = c * width_N - v * m1 / (h1 * h1);                 /* dh/dt at t = 1 */
+    const float u2 = u * u;
+    const float u3 = u2 * u;
+    float t = (3.0f * u2 - 2.0f * u3) + (u3 - 2.0f * u2 + u) * (span_Nm / slope0) + (u3 - u2) * (span_Nm / slope1);
+    t = (t > 0.0f) ? ((t < 1.0f) ? t : 1.0f) : 0.0f;
     float t_lo = 0.0f;
     float t_hi = 1.0f;
     uint32_t i = 0u;

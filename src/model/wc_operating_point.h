@@ -38,7 +38,22 @@ wc_status_t wc_inverse_rejected(const wc_model_t *model, wc_status_t status, wc_
 
 /* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]
  * (p = p_k + t (p_k+1 - p_k)): h_bar(t) = c[0] + t (c[1] + t (c[2] + t c[3])).
- * The same cubic Hermite as wc_film_hbar_m, in the power basis (eq. 9, 15, 16). */
-void wc_film_segment_cubic(const wc_film_table_t *table, uint32_t k, float coefficient[4]);
+ * The same cubic Hermite as wc_film_hbar_m (wc_film.c), in the power basis
+ * (eq. 9, 15, 16); tests/c/test_film.c checks the two agree. Inline: the
+ * inverse calls it once per solve on its hot path. */
+static inline void wc_film_segment_cubic(const wc_film_table_t *table, uint32_t k, float coefficient[4])
+{
+    /* The Hermite basis expanded in powers of t, with the slopes scaled to
+     * the segment: m = (p_k+1 - p_k) dh_bar/dp_c. */
+    const float width_Pa = table->pressure_Pa[k + 1u] - table->pressure_Pa[k];
+    const float h0 = table->hbar_m[k];
+    const float h1 = table->hbar_m[k + 1u];
+    const float m0 = width_Pa * table->slope_m_per_Pa[k];
+    const float m1 = width_Pa * table->slope_m_per_Pa[k + 1u];
+    coefficient[0] = h0;
+    coefficient[1] = m0;
+    coefficient[2] = 3.0f * (h1 - h0) - 2.0f * m0 - m1;
+    coefficient[3] = 2.0f * (h0 - h1) + m0 + m1;
+}
 
 #endif /* WC_OPERATING_POINT_H */

@@ -318,7 +318,7 @@ def helper(tmp_path_factory):
     src.write_text(HELPER_C)
     exe = work / "helper"
     subprocess.run(
-        [cc, "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", f"-I{INCLUDE}",
+        [cc, "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", f"-I{INCLUDE}", f"-I{CAN_SRC}",
          str(src), str(CAN_SRC / "wc_can_scaling.c"), str(CAN_SRC / "wc_e2e.c"),
          str(GENERATED / "wc_can.c"), str(GENERATED / "wc_can_signals.c"), "-lm", "-o", str(exe)],
         check=True, capture_output=True, text=True)

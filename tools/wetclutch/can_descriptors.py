@@ -69,6 +69,7 @@ class Message:
     snake: str
     frame_id: int
     signals: list[Signal]
+    status_start: int = 0   # frame bit of status word bit 0
 
     @property
     def upper(self) -> str:
@@ -144,7 +145,9 @@ def messages(dbc_path: Path) -> list[Message]:
                 raise GenerateError(f"{m.name}: status bits must be contiguous, at most 16")
         if len({s.kind for s in sigs} & {"crc", "counter"}) == 1:
             raise GenerateError(f"{m.name}: an E2E frame needs both Crc and AliveCounter")
-        out.append(Message(m.name, camel_to_snake_case(m.name), m.frame_id, sigs))
+        out.append(Message(m.name, camel_to_snake_case(m.name), m.frame_id, sigs,
+                           status_start=min((s.start for s in m.signals if s.name.startswith("Status") and s.length == 1),
+                                            default=0)))
     return out
 
 
@@ -228,21 +231,31 @@ def _descriptor(m: Message, s: Signal) -> str:
 def _encode(m: Message) -> str:
     t = f"{PREFIX}_{m.snake}_phys_t"
     lines = [f"wc_can_result_t {PREFIX}_encode_{m.snake}(uint8_t *dst, const {t} *src, size_t size)", "{",
-             f"    struct {PREFIX}_{m.snake}_t msg;", "    wc_can_result_t result = WC_CAN_OK;", "",
+             f"    struct {PREFIX}_{m.snake}_t msg = {{ 0u }};  /* every field not set below is 0 */",
+             "    wc_can_result_t result = WC_CAN_OK;", "",
              f"    if ((dst == NULL) || (src == NULL) || (size < {m.upper}_LENGTH)) {{",
-             "        return WC_CAN_ERR_SIZE;", "    }",
-             f"    (void){PREFIX}_{m.snake}_init(&msg);"]
+             "        return WC_CAN_ERR_SIZE;", "    }"]
     for s in m.of("scaled"):
         lines.append(f"    msg.{s.snake} = ({s.c_raw_type})to_raw(&{_desc_name(m, s)}, src->{s.field}, &result);")
     for s in m.of("enum"):
         lines.append(f"    msg.{s.snake} = ({s.c_raw_type})(src->{s.field} & 0x{(1 << s.length) - 1:02X}u);")
-        lines.append(f"    if (src->{s.field} > {s.raw_max}u) {{ result = wc_can_worst(result, WC_CAN_ERR_RANGE); }}")
-    for s in m.of("status"):
-        lines.append(f"    msg.{s.snake} = status_bit(src->status, {s.bit}u);")
+        lines.append(f"    if (src->{s.field} > {s.raw_max}u) {{ result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }}")
     if m.e2e:
         lines.append("    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);")
         lines.append("    msg.crc = 0u;")
     lines += [f"    if ({PREFIX}_{m.snake}_pack(dst, &msg, size) < 0) {{", "        return WC_CAN_ERR_SIZE;", "    }"]
+    status = m.of("status")
+    if status:
+        # The status signals are contiguous little-endian bits from status_start:
+        # OR the whole word into its bytes (cantools' per-bit fields stay 0).
+        mask = (1 << len(status)) - 1
+        shift = m.status_start % 8
+        first_byte = m.status_start // 8
+        last_byte = (m.status_start + len(status) - 1) // 8
+        lines.append(f"    const uint32_t status_bits = ((uint32_t)src->status & 0x{mask:X}u) << {shift};"
+                     f"  /* frame bits {m.status_start}..{m.status_start + len(status) - 1} */")
+        for b in range(first_byte, last_byte + 1):
+            lines.append(f"    dst[{b}] = (uint8_t)(dst[{b}] | (uint8_t)(status_bits >> {8 * (b - first_byte)}));")
     if m.e2e:
         lines.append(f"    (void)wc_e2e_protect({m.upper}_FRAME_ID, dst, size);")
     lines += ["    return result;", "}"]
@@ -266,7 +279,7 @@ def _decode(m: Message) -> str:
     for s in m.of("enum"):
         lines.append(f"    dst->{s.field} = msg.{s.snake};")
         lines.append(f"    if (!{PREFIX}_{m.snake}_{s.snake}_is_in_range(msg.{s.snake})) {{")
-        lines.append("        result = wc_can_worst(result, WC_CAN_ERR_RANGE);")
+        lines.append("        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);")
         lines.append("    }")
     for s in m.of("status"):
         lines.append(f"    status |= (uint32_t)(msg.{s.snake} & 1u) << {s.bit};")
@@ -279,43 +292,37 @@ def _decode(m: Message) -> str:
 
 
 _HELPERS = """\
-/* Converts one value and folds its result into *acc; returns the raw value. */
-static int32_t to_raw(const wc_can_signal_t *sig, float value, wc_can_result_t *acc)
+/* Converts one value and folds its result into *acc; returns the raw value.
+ * The scaling is inlined, so each call folds its descriptor's constants. */
+WC_INLINE_HOT int32_t to_raw(const wc_can_signal_t *sig, float value, wc_can_result_t *acc)
 {
     int32_t raw = 0;
 
-    *acc = wc_can_worst(*acc, wc_can_phys_to_raw(sig, value, &raw));
+    *acc = wc_can_worst_of(*acc, wc_can_scale_to_raw(sig, value, &raw));
     return raw;
 }
 
-static float to_phys(const wc_can_signal_t *sig, int32_t raw, wc_can_result_t *acc)
+WC_INLINE_HOT float to_phys(const wc_can_signal_t *sig, int32_t raw, wc_can_result_t *acc)
 {
     float value = 0.0f;
 
-    *acc = wc_can_worst(*acc, wc_can_raw_to_phys(sig, raw, &value));
+    *acc = wc_can_worst_of(*acc, wc_can_scale_to_phys(sig, raw, &value));
     return value;
 }
 """
 
-_STATUS_HELPER = """
-static uint8_t status_bit(uint16_t status, unsigned bit)
-{
-    return (uint8_t)(((uint32_t)status >> bit) & 1u);
-}
-"""
+
 
 
 def source(msgs: list[Message]) -> str:
     out = [BANNER, '#include "wetclutch_can/wc_can_signals.h"\n\n',
-           '#include "wetclutch_can/wc_e2e.h"\n\n',
+           '#include "wetclutch_can/wc_e2e.h"\n#include "wc_can_scaling_inline.h"  /* inlined: descriptors are constants here */\n\n',
            "/* ---- signal descriptors (DBC: raw = (value - offset) / factor) ---- */\n\n"]
     for m in msgs:
         for s in m.of("scaled"):
             out.append(_descriptor(m, s))
     out.append("\n/* ---- frames ---- */\n\n")
     out.append(_HELPERS)
-    if any(m.of("status") for m in msgs):
-        out.append(_STATUS_HELPER)
     for m in msgs:
         out.append(f"\n/* {m.name}{' (E2E)' if m.e2e else ''} */\n\n")
         out.append(_encode(m) + "\n\n" + _decode(m) + "\n")

@@ -2,6 +2,7 @@
 #include "wetclutch_can/wc_can_signals.h"
 
 #include "wetclutch_can/wc_e2e.h"
+#include "wc_can_scaling_inline.h"  /* inlined: descriptors are constants here */
 
 /* ---- signal descriptors (DBC: raw = (value - offset) / factor) ---- */
 
@@ -60,39 +61,34 @@ const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp = {
 
 /* ---- frames ---- */
 
-/* Converts one value and folds its result into *acc; returns the raw value. */
-static int32_t to_raw(const wc_can_signal_t *sig, float value, wc_can_result_t *acc)
+/* Converts one value and folds its result into *acc; returns the raw value.
+ * The scaling is inlined, so each call folds its descriptor's constants. */
+WC_INLINE_HOT int32_t to_raw(const wc_can_signal_t *sig, float value, wc_can_result_t *acc)
 {
     int32_t raw = 0;
 
-    *acc = wc_can_worst(*acc, wc_can_phys_to_raw(sig, value, &raw));
+    *acc = wc_can_worst_of(*acc, wc_can_scale_to_raw(sig, value, &raw));
     return raw;
 }
 
-static float to_phys(const wc_can_signal_t *sig, int32_t raw, wc_can_result_t *acc)
+WC_INLINE_HOT float to_phys(const wc_can_signal_t *sig, int32_t raw, wc_can_result_t *acc)
 {
     float value = 0.0f;
 
-    *acc = wc_can_worst(*acc, wc_can_raw_to_phys(sig, raw, &value));
+    *acc = wc_can_worst_of(*acc, wc_can_scale_to_phys(sig, raw, &value));
     return value;
-}
-
-static uint8_t status_bit(uint16_t status, unsigned bit)
-{
-    return (uint8_t)(((uint32_t)status >> bit) & 1u);
 }
 
 /* ClutchSensors (E2E) */
 
 wc_can_result_t wc_can_encode_clutch_sensors(uint8_t *dst, const wc_can_clutch_sensors_phys_t *src, size_t size)
 {
-    struct wc_can_clutch_sensors_t msg;
+    struct wc_can_clutch_sensors_t msg = { 0u };  /* every field not set below is 0 */
     wc_can_result_t result = WC_CAN_OK;
 
     if ((dst == NULL) || (src == NULL) || (size < WC_CAN_CLUTCH_SENSORS_LENGTH)) {
         return WC_CAN_ERR_SIZE;
     }
-    (void)wc_can_clutch_sensors_init(&msg);
     msg.slip_speed = (int16_t)to_raw(&wc_can_sig_clutch_sensors_slip_speed, src->slip_speed_rpm, &result);
     msg.oil_temp = (uint16_t)to_raw(&wc_can_sig_clutch_sensors_oil_temp, src->oil_temp_degC, &result);
     msg.housing_temp = (uint16_t)to_raw(&wc_can_sig_clutch_sensors_housing_temp, src->housing_temp_degC, &result);
@@ -130,16 +126,15 @@ wc_can_result_t wc_can_decode_clutch_sensors(wc_can_clutch_sensors_phys_t *dst, 
 
 wc_can_result_t wc_can_encode_torque_request(uint8_t *dst, const wc_can_torque_request_phys_t *src, size_t size)
 {
-    struct wc_can_torque_request_t msg;
+    struct wc_can_torque_request_t msg = { 0u };  /* every field not set below is 0 */
     wc_can_result_t result = WC_CAN_OK;
 
     if ((dst == NULL) || (src == NULL) || (size < WC_CAN_TORQUE_REQUEST_LENGTH)) {
         return WC_CAN_ERR_SIZE;
     }
-    (void)wc_can_torque_request_init(&msg);
     msg.torque_request = (uint16_t)to_raw(&wc_can_sig_torque_request_torque_request, src->torque_request_Nm, &result);
     msg.mode = (uint8_t)(src->mode & 0x0Fu);
-    if (src->mode > 2u) { result = wc_can_worst(result, WC_CAN_ERR_RANGE); }
+    if (src->mode > 2u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
     msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
     msg.crc = 0u;
     if (wc_can_torque_request_pack(dst, &msg, size) < 0) {
@@ -166,7 +161,7 @@ wc_can_result_t wc_can_decode_torque_request(wc_can_torque_request_phys_t *dst, 
     dst->torque_request_Nm = to_phys(&wc_can_sig_torque_request_torque_request, msg.torque_request, &result);
     dst->mode = msg.mode;
     if (!wc_can_torque_request_mode_is_in_range(msg.mode)) {
-        result = wc_can_worst(result, WC_CAN_ERR_RANGE);
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
     }
     dst->alive_counter = msg.alive_counter;
     return result;
@@ -176,30 +171,22 @@ wc_can_result_t wc_can_decode_torque_request(wc_can_torque_request_phys_t *dst, 
 
 wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command_phys_t *src, size_t size)
 {
-    struct wc_can_vfs_command_t msg;
+    struct wc_can_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
     wc_can_result_t result = WC_CAN_OK;
 
     if ((dst == NULL) || (src == NULL) || (size < WC_CAN_VFS_COMMAND_LENGTH)) {
         return WC_CAN_ERR_SIZE;
     }
-    (void)wc_can_vfs_command_init(&msg);
     msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_vfs_command_vfs_current, src->vfs_current_mA, &result);
     msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_vfs_command_pressure_command, src->pressure_command_kPa, &result);
-    msg.status_sensor_timeout = status_bit(src->status, 0u);
-    msg.status_request_timeout = status_bit(src->status, 1u);
-    msg.status_crc_error = status_bit(src->status, 2u);
-    msg.status_counter_error = status_bit(src->status, 3u);
-    msg.status_implausible_input = status_bit(src->status, 4u);
-    msg.status_saturated = status_bit(src->status, 5u);
-    msg.status_current_clamped = status_bit(src->status, 6u);
-    msg.status_below_drag = status_bit(src->status, 7u);
-    msg.status_safe_state_active = status_bit(src->status, 8u);
-    msg.status_deadline_miss = status_bit(src->status, 9u);
     msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
     msg.crc = 0u;
     if (wc_can_vfs_command_pack(dst, &msg, size) < 0) {
         return WC_CAN_ERR_SIZE;
     }
+    const uint32_t status_bits = ((uint32_t)src->status & 0x3FFu) << 0;  /* frame bits 48..57 */
+    dst[6] = (uint8_t)(dst[6] | (uint8_t)(status_bits >> 0));
+    dst[7] = (uint8_t)(dst[7] | (uint8_t)(status_bits >> 8));
     (void)wc_e2e_protect(WC_CAN_VFS_COMMAND_FRAME_ID, dst, size);
     return result;
 }
@@ -240,13 +227,12 @@ wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const 
 
 wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_estimate_phys_t *src, size_t size)
 {
-    struct wc_can_clutch_estimate_t msg;
+    struct wc_can_clutch_estimate_t msg = { 0u };  /* every field not set below is 0 */
     wc_can_result_t result = WC_CAN_OK;
 
     if ((dst == NULL) || (src == NULL) || (size < WC_CAN_CLUTCH_ESTIMATE_LENGTH)) {
         return WC_CAN_ERR_SIZE;
     }
-    (void)wc_can_clutch_estimate_init(&msg);
     msg.estimated_clutch_temp = (uint16_t)to_raw(&wc_can_sig_clutch_estimate_estimated_clutch_temp, src->estimated_clutch_temp_degC, &result);
     msg.model_torque = (int16_t)to_raw(&wc_can_sig_clutch_estimate_model_torque, src->model_torque_Nm, &result);
     msg.mu_f = (uint16_t)to_raw(&wc_can_sig_clutch_estimate_mu_f, src->mu_f, &result);
@@ -279,13 +265,12 @@ wc_can_result_t wc_can_decode_clutch_estimate(wc_can_clutch_estimate_phys_t *dst
 
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size)
 {
-    struct wc_can_bench_measurement_t msg;
+    struct wc_can_bench_measurement_t msg = { 0u };  /* every field not set below is 0 */
     wc_can_result_t result = WC_CAN_OK;
 
     if ((dst == NULL) || (src == NULL) || (size < WC_CAN_BENCH_MEASUREMENT_LENGTH)) {
         return WC_CAN_ERR_SIZE;
     }
-    (void)wc_can_bench_measurement_init(&msg);
     msg.load_cell_force = (int32_t)to_raw(&wc_can_sig_bench_measurement_load_cell_force, src->load_cell_force_N, &result);
     msg.measured_torque = (int32_t)to_raw(&wc_can_sig_bench_measurement_measured_torque, src->measured_torque_Nm, &result);
     msg.clutch_thermistor_temp = (uint16_t)to_raw(&wc_can_sig_bench_measurement_clutch_thermistor_temp, src->clutch_thermistor_temp_degC, &result);
