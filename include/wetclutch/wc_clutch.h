@@ -62,9 +62,10 @@ typedef struct {
 
 typedef struct {
     wc_model_t model;
-    float theta_degC;           /* observer state */
+    float theta_degC;           /* observer state, in [WC_THETA_MIN_degC, WC_THETA_MAX_degC] */
     float pressure_model_Pa;    /* VFS lag state */
     wc_held_inputs_t held;
+    bool over_temperature;      /* WC_STATUS_OVER_TEMPERATURE with hysteresis */
 } wc_clutch_t;
 
 /* Validate cal and start the observer at theta_start_degC (the oil
@@ -82,8 +83,14 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *  3. VFS lag -> modelled pressure -> contact force (on a bench: the measured
  *     apply force) -> torque model;
  *  4. observer advanced with P = |T dw|, T the model torque (on a bench: the
- *     measured torque). Implausible bench values are flagged and not used.
- * out->theta_degC is the estimate before this step's update. */
+ *     measured torque), kept in the thermal envelope; above
+ *     WC_THETA_OVER_degC WC_STATUS_OVER_TEMPERATURE is set until the estimate
+ *     falls WC_THETA_OVER_HYSTERESIS_K below it. Implausible bench values are
+ *     flagged and not used.
+ * out->theta_degC is the estimate before this step's update. A NULL pointer
+ * or an instance whose init failed (or never ran: zero-filled) is a contract
+ * violation: WC_ASSERT, and with asserts off zero outputs (0 mA) and
+ * WC_STATUS_NOT_INITIALISED. */
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out);
 
 #endif /* WC_CLUTCH_H */

@@ -38,6 +38,16 @@
 #ifndef WC_THETA_MAX_degC
 #define WC_THETA_MAX_degC 250.0f
 #endif
+/* Thermal envelope (DESIGN section 8): the observer's estimate is kept in
+ * [WC_THETA_MIN_degC, WC_THETA_MAX_degC], where the maps are valid; above
+ * WC_THETA_OVER_degC the status says over-temperature until the estimate
+ * falls below WC_THETA_OVER_degC - WC_THETA_OVER_HYSTERESIS_K. */
+#ifndef WC_THETA_OVER_degC
+#define WC_THETA_OVER_degC 200.0f
+#endif
+#ifndef WC_THETA_OVER_HYSTERESIS_K
+#define WC_THETA_OVER_HYSTERESIS_K 10.0f
+#endif
 #ifndef WC_FORCE_MAX_N
 #define WC_FORCE_MAX_N 100000.0f
 #endif

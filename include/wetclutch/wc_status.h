@@ -17,6 +17,8 @@ typedef uint32_t wc_status_t;
 #define WC_STATUS_FORCE_INVALID    (1u << 5)  /* contact force NaN, infinite, negative or too large */
 #define WC_STATUS_TORQUE_INVALID   (1u << 6)  /* torque request NaN, infinite, negative or too large */
 #define WC_STATUS_POWER_INVALID    (1u << 7)  /* heat input NaN, infinite or negative */
+#define WC_STATUS_OVER_TEMPERATURE (1u << 8)  /* temperature estimate above WC_THETA_OVER_degC (hysteresis) */
+#define WC_STATUS_NOT_INITIALISED  (1u << 9)  /* NULL or uninitialised instance (asserts off): zero outputs */
 
 /* Any of the input-rejection bits. */
 #define WC_STATUS_INPUT_INVALID \

@@ -8,7 +8,8 @@
 #include "wc_model.h"
 #include "wc_status.h"
 
-/* Advance *theta_degC by one period with heat input power_W = |T dw|.
+/* Advance *theta_degC by one period with heat input power_W = |T dw|; the
+ * result is kept in [WC_THETA_MIN_degC, WC_THETA_MAX_degC] (thermal envelope).
  * Invalid input: *theta_degC is left unchanged and the status says why. */
 wc_status_t wc_thermal_step(const wc_model_t *model, float *theta_degC, float power_W,
                             float theta_oil_degC, float theta_housing_degC);

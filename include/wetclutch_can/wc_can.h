@@ -131,6 +131,10 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_STATUS_BELOW_DRAG_NAME "StatusBelowDrag"
 #define WC_CAN_VFS_COMMAND_STATUS_SAFE_STATE_ACTIVE_NAME "StatusSafeStateActive"
 #define WC_CAN_VFS_COMMAND_STATUS_DEADLINE_MISS_NAME "StatusDeadlineMiss"
+#define WC_CAN_VFS_COMMAND_STATUS_OVER_TEMPERATURE_NAME "StatusOverTemperature"
+#define WC_CAN_VFS_COMMAND_STATUS_BENCH_INPUT_NAME "StatusBenchInput"
+#define WC_CAN_VFS_COMMAND_STATUS_FRAME_LOST_NAME "StatusFrameLost"
+#define WC_CAN_VFS_COMMAND_STATUS_BUS_ERROR_NAME "StatusBusError"
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_NAME "EstimatedClutchTemp"
 #define WC_CAN_CLUTCH_ESTIMATE_MODEL_TORQUE_NAME "ModelTorque"
 #define WC_CAN_CLUTCH_ESTIMATE_MU_F_NAME "MuF"
@@ -355,7 +359,7 @@ struct wc_can_vfs_command_t {
     uint8_t status_below_drag;
 
     /**
-     * Status bit 8: the loop outputs its defined safe state (minimum VFS current, clutch released; include/wc_loop.h) because an input timed out (no valid frame within its timeout: missing, corrupted or implausible frames).
+     * Status bit 8: the loop outputs its defined safe state (minimum VFS current, clutch released; include/wc_loop.h) because an input timed out (no valid frame within its timeout: missing, corrupted, out-of-sequence or implausible frames), or has not yet been fresh for the recovery period after one.
      *
      * Range: 0..1 (0..1 -)
      * Scale: 1
@@ -364,13 +368,49 @@ struct wc_can_vfs_command_t {
     uint8_t status_safe_state_active;
 
     /**
-     * Status bit 9: the real-time clock missed at least one step deadline since the previous VfsCommand. Bits 10..15 (frame bits 58..63) are reserved and sent as 0.
+     * Status bit 9: the real-time clock missed at least one step deadline since the previous VfsCommand.
      *
      * Range: 0..1 (0..1 -)
      * Scale: 1
      * Offset: 0
      */
     uint8_t status_deadline_miss;
+
+    /**
+     * Status bit 10: the estimated friction-surface temperature is above the over-temperature threshold (set above WC_THETA_OVER_degC, cleared below it minus WC_THETA_OVER_HYSTERESIS_K). The model keeps computing with the estimate clamped to its valid range.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_over_temperature;
+
+    /**
+     * Status bit 11: bench input (BenchMeasurement load cell and torque sensor) replaced the modelled force and heat input in this step. Only when enabled at init and on the command line (wc_tcu --bench).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_bench_input;
+
+    /**
+     * Status bit 12: since the previous VfsCommand a received frame was lost before it could be checked: receive ring full, DLC below 8, unknown id, extended/remote/error frame, or dropped by the port.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_frame_lost;
+
+    /**
+     * Status bit 13: the CAN controller reported a bus error (error passive, bus-off, controller problem) or a transmit failed since the previous VfsCommand. Bits 14..15 (frame bits 62..63) are reserved and sent as 0.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_bus_error;
 };
 
 /**
@@ -1070,6 +1110,94 @@ bool wc_can_vfs_command_status_deadline_miss_is_in_range(uint8_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_vfs_command_status_deadline_miss_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_over_temperature_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_over_temperature_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_bench_input_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_bench_input_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_frame_lost_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_frame_lost_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_bus_error_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_bus_error_is_in_phys_range(float value);
 
 /**
  * Pack message ClutchEstimate.

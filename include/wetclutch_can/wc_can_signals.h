@@ -25,9 +25,13 @@ extern "C" {
 #define WC_CAN_STATUS_BELOW_DRAG (1u << 7)
 #define WC_CAN_STATUS_SAFE_STATE_ACTIVE (1u << 8)
 #define WC_CAN_STATUS_DEADLINE_MISS (1u << 9)
-/** Bits 10..15 are reserved: ignored by the encoder, sent as 0. */
-#define WC_CAN_STATUS_DEFINED_MASK 0x03FFu
-#define WC_CAN_STATUS_BITS 10u
+#define WC_CAN_STATUS_OVER_TEMPERATURE (1u << 10)
+#define WC_CAN_STATUS_BENCH_INPUT (1u << 11)
+#define WC_CAN_STATUS_FRAME_LOST (1u << 12)
+#define WC_CAN_STATUS_BUS_ERROR (1u << 13)
+/** Bits 14..15 are reserved: ignored by the encoder, sent as 0. */
+#define WC_CAN_STATUS_DEFINED_MASK 0x3FFFu
+#define WC_CAN_STATUS_BITS 14u
 
 /* One descriptor per scaled signal (message_signal). */
 extern const wc_can_signal_t wc_can_sig_clutch_sensors_slip_speed; /* rpm */

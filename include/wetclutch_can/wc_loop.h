@@ -19,29 +19,40 @@
  *  - wc_loop_init runs before the interrupt that calls wc_loop_receive is
  *    enabled.
  *
- * Safe-state policy (also in README.md):
+ * Safe-state policy (also in README.md, with the reaction and recovery
+ * periods):
  *  - A received frame is used only if its length, CRC and alive counter are
  *    right and every signal is plausible (inside its DBC range, not SNA, Mode
- *    not reserved). Otherwise it is dropped and counted by reason; CRC,
+ *    not reserved). The alive counter follows AUTOSAR E2E Profile 1
+ *    (wc_e2e.h): a repeated counter is no new data; one lost frame is
+ *    tolerated; any other jump, and the first frame after init or a timeout,
+ *    restart the input, whose frames are used again only after SyncCounter
+ *    consecutive +1 frames. A rejected frame is counted by reason; CRC,
  *    counter and implausible rejections set StatusCrcError /
- *    StatusCounterError / StatusImplausibleInput in the next VfsCommand.
- *  - Between valid frames the last valid value of each input is held.
- *  - An input with no valid frame for its timeout (default 10 periods = 10 ms)
- *    is stale: StatusSensorTimeout or StatusRequestTimeout, plus
- *    StatusSafeStateActive, and the safe output: the solenoid's minimum
- *    current (clutch released: an element that cannot be controlled is opened;
- *    the transmission's limp-home strategy is the integrator's). The observer
- *    keeps running on the held temperatures with the released clutch.
- *  - The first valid frame after a timeout (its counter is taken as the new
- *    reference) ends the safe state for that input.
- *  - Before the first valid frame of each input the loop is in the safe state.
- *  - BenchMeasurement (bench only, no E2E): while fresh (same timeout as the
- *    sensors), its load-cell force replaces the modelled apply force in the
- *    torque model and its measured torque gives the observer's heat input
- *    (the paper's validation, Fig. 14/15; wc_bench_input_t); a negative force
- *    reading (load-cell noise at zero load) counts as 0 N. Stale or absent,
- *    the modelled VFS pressure and model torque are used: no safe state, no
- *    status bit.
+ *    StatusCounterError / StatusImplausibleInput in the next VfsCommand;
+ *    frames lost before the check (ring full, short, unknown id, format,
+ *    port drops) set StatusFrameLost.
+ *  - Between used frames the last used value of each input is held.
+ *  - An input with no used frame for its timeout (default 10 periods) is
+ *    stale: StatusSensorTimeout or StatusRequestTimeout, and its E2E receiver
+ *    restarts. While either control input is stale, and until both have been
+ *    fresh for recovery_periods (default 20) in a row, the loop outputs the
+ *    safe state, StatusSafeStateActive: the solenoid's minimum current
+ *    (clutch released: an element that cannot be controlled is opened; the
+ *    transmission's limp-home strategy is the integrator's). The observer
+ *    keeps running on the held temperatures with the released clutch. An
+ *    input that comes and goes therefore holds the safe state instead of
+ *    switching the solenoid.
+ *  - Before the inputs have been fresh for recovery_periods after init, the
+ *    loop is in the safe state.
+ *  - BenchMeasurement (bench only, no E2E) is used only when
+ *    bench_input_enabled (wc_tcu --bench; otherwise it is an unknown id and
+ *    the port filters it out). While fresh (same timeout as the sensors),
+ *    its load-cell force replaces the modelled apply force in the torque
+ *    model and its measured torque gives the observer's heat input (the
+ *    paper's validation, Fig. 14/15; wc_bench_input_t), and StatusBenchInput
+ *    is set; a negative force reading (load-cell noise at zero load) counts
+ *    as 0 N.
  */
 #ifndef WC_LOOP_H
 #define WC_LOOP_H
@@ -58,20 +69,24 @@
 #define WC_LOOP_TX_FRAMES 2u      /* VfsCommand, ClutchEstimate */
 
 typedef struct {
-    uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit */
-    uint32_t request_timeout_periods;  /* TorqueRequest freshness limit */
+    uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit (default 10) */
+    uint32_t request_timeout_periods;  /* TorqueRequest freshness limit (default 10) */
+    wc_e2e_config_t e2e;               /* MaxDeltaCounter 2 (one lost frame), SyncCounter 3 */
+    uint32_t recovery_periods;         /* both inputs fresh this long before the safe state ends (20) */
+    bool bench_input_enabled;          /* use BenchMeasurement (bench only; default off) */
 } wc_loop_config_t;
 
-#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u }
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false }
 
 typedef enum {
     WC_REJECT_CRC = 0,      /* E2E CRC mismatch */
-    WC_REJECT_COUNTER,      /* alive counter repeated or jumped */
+    WC_REJECT_COUNTER,      /* E2E REPEATED or WRONGSEQUENCE */
     WC_REJECT_SHORT,        /* DLC below 8 */
-    WC_REJECT_UNKNOWN_ID,   /* not a frame the TCU receives */
+    WC_REJECT_UNKNOWN_ID,   /* not a frame the TCU receives (BenchMeasurement when bench input is off) */
     WC_REJECT_FORMAT,       /* extended id, remote or error frame */
     WC_REJECT_IMPLAUSIBLE,  /* signal SNA, out of DBC range, or reserved Mode */
     WC_REJECT_OVERFLOW,     /* receive ring full: frame lost before the step */
+    WC_REJECT_SYNC,         /* E2E SYNC: after a timeout or wrong sequence, waiting for SyncCounter frames */
     WC_REJECT_REASONS
 } wc_loop_reject_t;
 
@@ -81,6 +96,8 @@ typedef struct {
     uint32_t frames_out;                    /* frames produced by wc_loop_step */
     uint32_t rejected[WC_REJECT_REASONS];
     uint32_t sensor_timeouts;               /* fresh -> stale transitions */
+    uint32_t frames_lost_by_port;           /* reported by the port (kernel drops) */
+    uint32_t bus_errors;                    /* reported by the port (error passive, bus-off, tx failure) */
     uint32_t request_timeouts;
     uint32_t safe_steps;                    /* steps spent in the safe state */
     uint32_t steps;
@@ -88,10 +105,10 @@ typedef struct {
 } wc_loop_counters_t;
 
 typedef struct {
-    uint32_t age_periods;           /* periods since the last valid frame */
-    bool seen;                      /* a valid frame since init or timeout */
+    uint32_t age_periods;           /* periods since the last frame used */
+    bool seen;                      /* a frame used since init or timeout */
     bool stale;
-    wc_e2e_counter_state_t alive;
+    wc_e2e_receiver_t e2e;
 } wc_loop_input_t;
 
 typedef struct {
@@ -106,6 +123,8 @@ typedef struct {
     wc_can_clutch_sensors_phys_t sensors;   /* last valid */
     wc_can_torque_request_phys_t request;   /* last valid */
     wc_can_bench_measurement_phys_t bench;  /* last valid */
+    uint32_t fresh_periods;                 /* consecutive periods with both control inputs fresh */
+    uint32_t overflows_seen;                /* rejected[WC_REJECT_OVERFLOW] at the last step */
     uint16_t pending_status;                /* event bits for the next VfsCommand */
     uint8_t tx_alive;
     wc_loop_counters_t counters;
@@ -122,6 +141,16 @@ bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame);
 
 /* The port missed `missed` step deadlines: counted, flagged in the next VfsCommand. */
 void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed);
+
+/* What a port reports about the bus. Each is counted and flagged in the next
+ * VfsCommand: frames lost before the loop saw them -> StatusFrameLost; a
+ * controller error or a failed transmit -> StatusBusError. */
+typedef enum {
+    WC_LOOP_PORT_RX_DROPPED = 0,  /* frames dropped by the port or its kernel (count) */
+    WC_LOOP_PORT_BUS_ERROR,       /* error passive, bus-off, controller problem (count = events) */
+    WC_LOOP_PORT_TX_FAILED        /* a frame could not be sent (count) */
+} wc_loop_port_event_t;
+void wc_loop_port_event(wc_loop_t *loop, wc_loop_port_event_t event, uint32_t count);
 
 /* One control period: process the queued frames, update freshness, step the
  * model, and write the output frames (VfsCommand, ClutchEstimate) to out.
@@ -142,7 +171,8 @@ typedef enum {
 uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
                          wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
-/* Receive filter ids for the port (the frames wc_loop_receive uses). */
+/* Receive filter ids for the port: the control frames, then BenchMeasurement,
+ * which a port passes only when bench input is enabled (count - 1 otherwise). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
                          WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
 #define WC_LOOP_RX_ID_COUNT 3u

@@ -2,12 +2,39 @@
 #include "wetclutch_can/wc_e2e.h"
 
 #include <wetclutch/wc_config.h>
+#include <stddef.h>
 
-/* The CRC-8 register after shifting byte n through eight steps of
- * polynomial 0x1D (non-reflected): one lookup a byte instead of eight
- * conditional shifts; 256 bytes of flash for about 100 instructions saved
- * per frame on a Cortex-M4F (bench/arm). tests/c/test_can_codec.c checks
- * it against the bitwise definition for every pair of bytes. */
+/* CRC-8 by table, two sizes of the same definition (tests/c/test_can_codec.c
+ * checks each against the bitwise one, for every pair of bytes):
+ *  - byte table: the register after shifting byte n through eight steps of
+ *    polynomial 0x1D; one lookup a byte, 256 bytes of flash (the default
+ *    when optimising for speed: about 100 instructions saved per frame);
+ *  - nibble table: after four steps; two lookups a byte, 16 bytes (the
+ *    default at -Os, where the CAN layer's flash budget is 6 KiB).
+ * WC_E2E_CRC_NIBBLE_TABLE set to 0 or 1 chooses explicitly. */
+#ifndef WC_E2E_CRC_NIBBLE_TABLE
+#if defined(__OPTIMIZE_SIZE__)
+#define WC_E2E_CRC_NIBBLE_TABLE 1
+#else
+#define WC_E2E_CRC_NIBBLE_TABLE 0
+#endif
+#endif
+
+#if WC_E2E_CRC_NIBBLE_TABLE
+static const uint8_t crc8_nibble[16] = {
+    0x00u, 0x1Du, 0x3Au, 0x27u, 0x74u, 0x69u, 0x4Eu, 0x53u,
+    0xE8u, 0xF5u, 0xD2u, 0xCFu, 0x9Cu, 0x81u, 0xA6u, 0xBBu,
+};
+
+/* One byte into the CRC-8 register. */
+static uint8_t crc8_j1850_update(uint8_t crc, uint8_t byte)
+{
+    uint8_t reg = (uint8_t)(crc ^ byte);
+    reg = (uint8_t)((uint8_t)(reg << 4) ^ crc8_nibble[reg >> 4]);
+    reg = (uint8_t)((uint8_t)(reg << 4) ^ crc8_nibble[reg >> 4]);
+    return reg;
+}
+#else
 static const uint8_t crc8_table[256] = {
     0x00u, 0x1Du, 0x3Au, 0x27u, 0x74u, 0x69u, 0x4Eu, 0x53u, 0xE8u, 0xF5u, 0xD2u, 0xCFu,
     0x9Cu, 0x81u, 0xA6u, 0xBBu, 0xCDu, 0xD0u, 0xF7u, 0xEAu, 0xB9u, 0xA4u, 0x83u, 0x9Eu,
@@ -33,14 +60,15 @@ static const uint8_t crc8_table[256] = {
     0xE3u, 0xFEu, 0xD9u, 0xC4u,
 };
 
-/* The frame CRC covers the bytes after the CRC byte, which comes first. */
-WC_STATIC_ASSERT(WC_E2E_CRC_BYTE == 0u, e2e_crc_is_byte_0);
-
 /* One byte into the CRC-8 register. */
 static uint8_t crc8_j1850_update(uint8_t crc, uint8_t byte)
 {
     return crc8_table[(uint8_t)(crc ^ byte)];
 }
+#endif
+
+/* The frame CRC covers the bytes after the CRC byte, which comes first. */
+WC_STATIC_ASSERT(WC_E2E_CRC_BYTE == 0u, e2e_crc_is_byte_0);
 
 uint8_t wc_e2e_crc8_j1850(const uint8_t *data, size_t len)
 {
@@ -99,43 +127,87 @@ wc_e2e_result_t wc_e2e_check_crc(uint32_t frame_id, const uint8_t *frame,
     return (frame[WC_E2E_CRC_BYTE] == crc) ? WC_E2E_OK : WC_E2E_ERR_CRC;
 }
 
-void wc_e2e_counter_init(wc_e2e_counter_state_t *state)
+/* Receiver states (wc_e2e.h). */
+enum { RX_INIT = 0u, RX_NOSYNC = 1u, RX_SYNCING = 2u, RX_VALID = 3u };
+
+static void start(wc_e2e_receiver_t *rx, uint8_t state)
 {
-    if (state != NULL) {
-        state->previous = 0u;
-        state->synced = false;
+    if (rx != NULL) {
+        rx->previous = 0u;
+        rx->state = state;
+        rx->in_sequence = 0u;
+        rx->lost_last = false;
     }
 }
 
-wc_e2e_counter_result_t wc_e2e_counter_check(wc_e2e_counter_state_t *state,
-                                             uint8_t counter)
-{
-    const uint8_t received = (uint8_t)(counter & WC_E2E_COUNTER_MASK);
-    uint8_t delta;
+void wc_e2e_receiver_init(wc_e2e_receiver_t *rx) { start(rx, RX_INIT); }
 
-    if (state == NULL) {
-        return WC_E2E_COUNTER_WRONG_SEQUENCE;
+void wc_e2e_receiver_restart(wc_e2e_receiver_t *rx) { start(rx, RX_NOSYNC); }
+
+/* Start over from this counter: SyncCounter +1 frames needed. */
+static wc_e2e_status_t resynchronise(wc_e2e_receiver_t *rx, uint8_t received, wc_e2e_status_t status)
+{
+    rx->previous = received;
+    rx->state = RX_SYNCING;
+    rx->in_sequence = 0u;
+    rx->lost_last = false;
+    return status;
+}
+
+wc_e2e_status_t wc_e2e_receive(wc_e2e_receiver_t *rx, const wc_e2e_config_t *config, uint8_t counter)
+{
+    if ((rx == NULL) || (config == NULL)) {
+        return WC_E2E_STATUS_WRONGSEQUENCE;
     }
-    if (!state->synced) {
-        state->previous = received;
-        state->synced = true;
-        return WC_E2E_COUNTER_INITIAL;
+    const uint8_t received = (uint8_t)(counter & WC_E2E_COUNTER_MASK);
+    const uint8_t delta = (uint8_t)((uint8_t)(received - rx->previous) & WC_E2E_COUNTER_MASK);
+    if ((rx->state == RX_VALID) && (delta == 1u)) {  /* the usual frame first */
+        rx->previous = received;
+        rx->lost_last = false;
+        return WC_E2E_STATUS_OK;
     }
-    delta = (uint8_t)((uint8_t)(received - state->previous) & WC_E2E_COUNTER_MASK);
-    if (delta == 1u) {
-        state->previous = received;
-        return WC_E2E_COUNTER_OK;
+    if (rx->state == RX_INIT) {
+        rx->previous = received;
+        rx->state = RX_VALID;
+        return WC_E2E_STATUS_INITIAL;
+    }
+    if (rx->state == RX_NOSYNC) {
+        return resynchronise(rx, received, WC_E2E_STATUS_SYNC);
     }
     if (delta == 0u) {
-        return WC_E2E_COUNTER_REPEATED;
+        return WC_E2E_STATUS_REPEATED;  /* no new data; the reference stays */
     }
-    state->previous = received; /* resynchronise */
-    return WC_E2E_COUNTER_WRONG_SEQUENCE;
+    if (rx->state == RX_SYNCING) {
+        if (delta != 1u) {
+            return resynchronise(rx, received, WC_E2E_STATUS_WRONGSEQUENCE);
+        }
+        rx->previous = received;
+        rx->in_sequence++;
+        if (rx->in_sequence < config->sync_counter) {
+            return WC_E2E_STATUS_SYNC;
+        }
+        rx->state = RX_VALID;
+        rx->lost_last = false;
+        return WC_E2E_STATUS_OK;
+    }
+    /* VALID */
+    if (delta == 1u) {
+        rx->previous = received;
+        rx->lost_last = false;
+        return WC_E2E_STATUS_OK;
+    }
+    if ((delta <= config->max_delta_counter) && !rx->lost_last) {
+        rx->previous = received;
+        rx->lost_last = true;
+        return WC_E2E_STATUS_OKSOMELOST;
+    }
+    return resynchronise(rx, received, WC_E2E_STATUS_WRONGSEQUENCE);
 }
 
-bool wc_e2e_counter_accepted(wc_e2e_counter_result_t result)
+bool wc_e2e_status_usable(wc_e2e_status_t status)
 {
-    return (result == WC_E2E_COUNTER_OK) || (result == WC_E2E_COUNTER_INITIAL);
+    return (status == WC_E2E_STATUS_OK) || (status == WC_E2E_STATUS_OKSOMELOST) ||
+           (status == WC_E2E_STATUS_INITIAL);
 }
 
 uint8_t wc_e2e_counter_next(uint8_t counter)

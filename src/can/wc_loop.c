@@ -22,7 +22,7 @@ static void input_reset(wc_loop_input_t *in)
     in->age_periods = 0u;
     in->seen = false;
     in->stale = true;
-    wc_e2e_counter_init(&in->alive);
+    wc_e2e_receiver_init(&in->e2e);
 }
 
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
@@ -43,15 +43,25 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     return WC_CAL_OK;
 }
 
+/* Status bit of each reject reason, indexed by wc_loop_reject_t in its
+ * order. SYNC frames are in sequence: no error, the input's timeout bit
+ * says it is not yet used. */
+static const uint16_t reject_flag[] = {
+    WC_CAN_STATUS_CRC_ERROR,          /* WC_REJECT_CRC */
+    WC_CAN_STATUS_COUNTER_ERROR,      /* WC_REJECT_COUNTER */
+    WC_CAN_STATUS_FRAME_LOST,         /* WC_REJECT_SHORT */
+    WC_CAN_STATUS_FRAME_LOST,         /* WC_REJECT_UNKNOWN_ID */
+    WC_CAN_STATUS_FRAME_LOST,         /* WC_REJECT_FORMAT */
+    WC_CAN_STATUS_IMPLAUSIBLE_INPUT,  /* WC_REJECT_IMPLAUSIBLE */
+    WC_CAN_STATUS_FRAME_LOST,         /* WC_REJECT_OVERFLOW (raised by the step, not the ISR) */
+    0u,                               /* WC_REJECT_SYNC */
+};
+WC_STATIC_ASSERT(sizeof reject_flag / sizeof reject_flag[0] == (size_t)WC_REJECT_REASONS, reject_flag_for_every_reason);
+
 static void reject(wc_loop_t *loop, wc_loop_reject_t reason)
 {
     loop->counters.rejected[reason]++;
-    static const uint16_t flag[WC_REJECT_REASONS] = {
-        [WC_REJECT_CRC] = WC_CAN_STATUS_CRC_ERROR,
-        [WC_REJECT_COUNTER] = WC_CAN_STATUS_COUNTER_ERROR,
-        [WC_REJECT_IMPLAUSIBLE] = WC_CAN_STATUS_IMPLAUSIBLE_INPUT,
-    };
-    loop->pending_status = (uint16_t)(loop->pending_status | flag[reason]);
+    loop->pending_status = (uint16_t)(loop->pending_status | reject_flag[reason]);
 }
 
 /* Producer side of the single-producer/single-consumer ring: writes only
@@ -59,6 +69,7 @@ static void reject(wc_loop_t *loop, wc_loop_reject_t reason)
 bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame)
 {
     WC_ASSERT((loop != NULL) && (frame != NULL));
+    if ((loop == NULL) || (frame == NULL)) { return false; }
     loop->counters.frames_in++;
     const uint32_t tail = loop->rx_tail;
     if ((tail - loop->rx_head) >= WC_LOOP_RX_CAPACITY) {
@@ -74,9 +85,30 @@ bool wc_loop_receive(wc_loop_t *loop, const wc_can_frame_t *frame)
 void wc_loop_deadline_missed(wc_loop_t *loop, uint32_t missed)
 {
     WC_ASSERT(loop != NULL);
+    if (loop == NULL) { return; }
     loop->counters.deadline_misses += missed;
     if (missed > 0u) { loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_DEADLINE_MISS); }
 }
+
+void wc_loop_port_event(wc_loop_t *loop, wc_loop_port_event_t event, uint32_t count)
+{
+    WC_ASSERT(loop != NULL);
+    if ((loop == NULL) || (count == 0u)) { return; }
+    if (event == WC_LOOP_PORT_RX_DROPPED) {
+        loop->counters.frames_lost_by_port += count;
+        loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_FRAME_LOST);
+    } else {
+        loop->counters.bus_errors += count;
+        loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_BUS_ERROR);
+    }
+}
+
+/* accept() tests the usable E2E statuses and the decode errors by their order. */
+WC_STATIC_ASSERT((WC_E2E_STATUS_OK < WC_E2E_STATUS_SYNC) && (WC_E2E_STATUS_OKSOMELOST < WC_E2E_STATUS_SYNC) &&
+                 (WC_E2E_STATUS_INITIAL < WC_E2E_STATUS_SYNC) && (WC_E2E_STATUS_SYNC < WC_E2E_STATUS_REPEATED) &&
+                 (WC_E2E_STATUS_REPEATED < WC_E2E_STATUS_WRONGSEQUENCE) && (WC_E2E_STATUS_INITIAL == 2),
+                 e2e_usable_statuses_come_first);
+WC_STATIC_ASSERT((WC_CAN_SATURATED < WC_CAN_ERR_NAN) && (WC_CAN_ERR_NAN < WC_CAN_ERR_RANGE), can_errors_come_last);
 
 /* Map a decode result and (for E2E frames) the alive counter to use / reject. */
 static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, bool e2e, uint8_t alive)
@@ -85,11 +117,14 @@ static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded
     if (decoded == WC_CAN_ERR_CRC) { reject(loop, WC_REJECT_CRC); return false; }
     /* The counter is checked before plausibility: an implausible frame still
      * proves the sender is alive and in sequence. */
-    if (e2e && !wc_e2e_counter_accepted(wc_e2e_counter_check(&in->alive, alive))) {
-        reject(loop, WC_REJECT_COUNTER);
-        return false;
+    if (e2e) {
+        const wc_e2e_status_t status = wc_e2e_receive(&in->e2e, &loop->config.e2e, alive);
+        if (status > WC_E2E_STATUS_INITIAL) {  /* wc_e2e_status_usable, inline: see the asserts below */
+            reject(loop, (status == WC_E2E_STATUS_SYNC) ? WC_REJECT_SYNC : WC_REJECT_COUNTER);
+            return false;
+        }
     }
-    if (wc_can_is_error(decoded)) { reject(loop, WC_REJECT_IMPLAUSIBLE); return false; }
+    if (decoded >= WC_CAN_ERR_NAN) { reject(loop, WC_REJECT_IMPLAUSIBLE); return false; }  /* wc_can_is_error */
     in->age_periods = 0u;
     in->seen = true;
     loop->counters.frames_used++;
@@ -110,7 +145,7 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
         wc_can_torque_request_phys_t q = {0.0f, 0u, 0u};
         const wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
         if (accept(loop, &loop->request_in, r, true, q.alive_counter)) { loop->request = q; }
-    } else if (f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) {
+    } else if ((f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) && loop->config.bench_input_enabled) {
         wc_can_bench_measurement_phys_t b = {0.0f, 0.0f, 0.0f};
         const wc_can_result_t r = wc_can_decode_bench_measurement(&b, f->data, f->dlc);
         if (accept(loop, &loop->bench_in, r, false, 0u)) { loop->bench = b; }
@@ -125,8 +160,8 @@ static bool update_freshness(wc_loop_input_t *in, uint32_t timeout_periods, uint
     const bool stale = !in->seen || (in->age_periods >= timeout_periods);
     if (stale && !in->stale && in->seen) {
         (*timeouts)++;
-        in->seen = false;              /* the next valid frame restarts the input... */
-        wc_e2e_counter_init(&in->alive);  /* ...and its counter is the new reference */
+        in->seen = false;
+        wc_e2e_receiver_restart(&in->e2e);  /* the input must prove itself: reference + SyncCounter frames */
     }
     in->stale = stale;
     if (in->age_periods < UINT32_MAX) { in->age_periods++; }
@@ -155,11 +190,16 @@ static const wc_status_map_t status_map[] = {
     { WC_STATUS_CURRENT_CLAMPED, WC_CAN_STATUS_CURRENT_CLAMPED },
     { WC_STATUS_BELOW_DRAG, WC_CAN_STATUS_BELOW_DRAG },
     { WC_STATUS_INPUT_INVALID, WC_CAN_STATUS_IMPLAUSIBLE_INPUT },
+    { WC_STATUS_OVER_TEMPERATURE, WC_CAN_STATUS_OVER_TEMPERATURE },
+    { WC_STATUS_NOT_INITIALISED, WC_CAN_STATUS_SAFE_STATE_ACTIVE },
 };
 
 static uint16_t status_bits(wc_status_t status)
 {
     uint16_t bits = 0u;
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__OPTIMIZE_SIZE__)
+#pragma GCC unroll 8  /* six fixed entries, every period (bench/arm) */
+#endif
     for (size_t i = 0u; i < (sizeof status_map / sizeof status_map[0]); ++i) {
         if ((status & status_map[i].model) != 0u) { bits = (uint16_t)(bits | status_map[i].can); }
     }
@@ -200,14 +240,27 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
     WC_ASSERT((loop != NULL) && (out != NULL));
-    WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
-    /* Consumer side of the ring: writes only rx_head. */
-    for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (loop->rx_head != loop->rx_tail); ++i) {
-        const uint32_t head = loop->rx_head;
-        WC_MEMORY_BARRIER();        /* the frame is read after its publication was seen */
-        process(loop, &loop->rx[head % WC_LOOP_RX_CAPACITY]);
-        WC_MEMORY_BARRIER();        /* ...and fully read before its slot is released */
-        loop->rx_head = head + 1u;  /* free-running: wraps at 2^32, a multiple of the capacity */
+    WC_ASSERT((loop == NULL) || (loop->clutch.model.cal != NULL));  /* initialised, and its init succeeded */
+    if ((loop == NULL) || (out == NULL)) { return 0u; }
+    /* With asserts off an uninitialised loop still answers: the clutch step
+     * gives 0 mA and WC_STATUS_NOT_INITIALISED, sent as the safe state. */
+    /* Consumer side of the ring: writes only rx_head. The frames queued when
+     * the step starts are this period's; one arriving meanwhile waits for the
+     * next step (its slot is not released before then). */
+    const uint32_t head = loop->rx_head;
+    const uint32_t tail = loop->rx_tail;
+    WC_MEMORY_BARRIER();  /* the frames are read after their publication was seen */
+    const uint32_t queued = tail - head;  /* free-running indices: <= WC_LOOP_RX_CAPACITY */
+    for (uint32_t i = 0u; (i < WC_LOOP_RX_CAPACITY) && (i < queued); ++i) {
+        process(loop, &loop->rx[(head + i) % WC_LOOP_RX_CAPACITY]);
+    }
+    WC_MEMORY_BARRIER();  /* ...and fully read before their slots are released */
+    loop->rx_head = tail; /* wraps at 2^32, a multiple of the capacity */
+    /* Frames the ISR could not queue since the last step (its counter is the producer's). */
+    const uint32_t overflows = loop->counters.rejected[WC_REJECT_OVERFLOW];
+    if (overflows != loop->overflows_seen) {
+        loop->overflows_seen = overflows;
+        loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_FRAME_LOST);
     }
     uint16_t bits = loop->pending_status;
     loop->pending_status = 0u;
@@ -217,9 +270,13 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
     if (update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
         bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
-    const bool safe = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) != 0u;
+    /* Debounce: both control inputs fresh for recovery_periods in a row. */
+    const bool fresh = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
+    loop->fresh_periods = fresh ? ((loop->fresh_periods < UINT32_MAX) ? loop->fresh_periods + 1u : UINT32_MAX) : 0u;
+    const bool safe = !fresh || (loop->fresh_periods < loop->config.recovery_periods);
     uint32_t bench_timeouts = 0u;  /* bench frames are optional: staleness is not a fault */
-    const bool bench_fresh = !update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
+    const bool bench_fresh = loop->config.bench_input_enabled &&
+                             !update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
     const float load_cell_N = loop->bench.load_cell_force_N;
 
     const wc_step_input_t in = {
@@ -231,6 +288,7 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         .bench = { bench_fresh, (load_cell_N > 0.0f) ? load_cell_N : 0.0f, loop->bench.measured_torque_Nm },
     };
     bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
+    if (bench_fresh) { bits |= WC_CAN_STATUS_BENCH_INPUT; }
     if (safe) {
         bits |= WC_CAN_STATUS_SAFE_STATE_ACTIVE;
         loop->counters.safe_steps++;
@@ -246,6 +304,7 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
                          wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
     WC_ASSERT((loop != NULL) && (out != NULL));
+    if ((loop == NULL) || (out == NULL)) { return 0u; }
     bool step_now = tick;
     if (frame != NULL) {
         (void)wc_loop_receive(loop, frame);  /* a refusal is counted (WC_REJECT_OVERFLOW) */

@@ -24,6 +24,7 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
     clutch->held.theta_oil_degC = theta;
     clutch->held.theta_housing_degC = theta;
     clutch->held.torque_request_Nm = 0.0f;
+    clutch->over_temperature = false;
     return WC_CAL_OK;
 }
 
@@ -45,7 +46,14 @@ static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
 {
     WC_ASSERT((clutch != NULL) && (in != NULL) && (out != NULL));
-    WC_ASSERT(clutch->model.cal != NULL);  /* initialised, and its init succeeded */
+    WC_ASSERT((clutch == NULL) || (clutch->model.cal != NULL));  /* initialised, and its init succeeded */
+    if ((clutch == NULL) || (in == NULL) || (out == NULL)) { return WC_STATUS_NOT_INITIALISED; }
+    if (clutch->model.cal == NULL) {
+        static const wc_step_output_t released = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
+                                                   { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f }, 0u, WC_STATUS_NOT_INITIALISED };
+        *out = released;  /* no calibration: no current at all */
+        return WC_STATUS_NOT_INITIALISED;
+    }
     const wc_model_t *model = &clutch->model;
     wc_status_t status = accept_inputs(&clutch->held, in);
     const wc_held_inputs_t *u = &clutch->held;
@@ -95,8 +103,16 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 
     /* eq. 1 heat input: friction power |T dw| */
     const float heat_torque_Nm = bench_torque ? in->bench.torque_Nm : out->model.torque_Nm;
-    const float power_W = fabsf(heat_torque_Nm * u->slip_rad_s);
-    status |= wc_thermal_step(model, &clutch->theta_degC, power_W, u->theta_oil_degC, u->theta_housing_degC);
+    const float power_W = fabsf(heat_torque_Nm * u->slip_rad_s);  /* finite: model or range-checked bench torque */
+    clutch->theta_degC = wc_thermal_advance(model, clutch->theta_degC, power_W, u->theta_oil_degC,
+                                            u->theta_housing_degC);  /* the held temperatures are valid */
+    /* Over-temperature with hysteresis on the updated estimate (DESIGN section 8). */
+    if (clutch->theta_degC > WC_THETA_OVER_degC) {
+        clutch->over_temperature = true;
+    } else if (clutch->theta_degC < WC_THETA_OVER_degC - WC_THETA_OVER_HYSTERESIS_K) {
+        clutch->over_temperature = false;
+    }
+    if (clutch->over_temperature) { status |= WC_STATUS_OVER_TEMPERATURE; }
     out->status = status;
     return status;
 }

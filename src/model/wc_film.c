@@ -7,6 +7,9 @@
 float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
 {
     WC_ASSERT(table != NULL);
+    if ((table == NULL) || (table->pressure_Pa == NULL) || (table->hbar_m == NULL) || (table->length < 2u)) {
+        return 0.0f;  /* contract violation with asserts off */
+    }
     const float *p = table->pressure_Pa;
     const uint32_t last = table->length - 1u;
     /* Clamp; the negated compare also sends NaN to the open-clutch end. */

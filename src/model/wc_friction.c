@@ -11,6 +11,7 @@
 float wc_friction_coefficient(const wc_calibration_t *cal, float speed_m_s, float theta_degC)
 {
     WC_ASSERT(cal != NULL);
+    if (cal == NULL) { return 0.0f; }
     /* eq. 18: Stribeck exponential in speed times a linear temperature term.
      * Above 30 Stribeck speeds e^-x < 1e-13: (mu2 - mu1) e^-x is below half an
      * ulp of mu1 unless |mu2 - mu1| > 6e5 mu1, so the sum is mu1 exactly and

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "wetclutch/wc_config.h"
+#include "wetclutch/wc_model.h"
 
 static inline bool wc_in_range(float x, float lo, float hi)
 {
@@ -22,6 +23,25 @@ static inline bool wc_slip_valid(float slip_rad_s)
 static inline bool wc_theta_valid(float theta_degC)
 {
     return wc_in_range(theta_degC, WC_THETA_MIN_degC, WC_THETA_MAX_degC);
+}
+
+/* One exact ZOH step of eq. 1 for validated inputs (wc_thermal_step checks
+ * them; wc_clutch_step's are checked on entry), kept in the thermal envelope
+ * (DESIGN section 8): the estimate stays where the maps are valid, and a heat
+ * input so large that the sum is not a number is a hot clutch, not an
+ * invalid one. */
+static inline float wc_thermal_advance(const wc_model_t *model, float theta_degC, float power_W,
+                                       float theta_oil_degC, float theta_housing_degC)
+{
+    const wc_calibration_t *cal = model->cal;
+    const float k1 = cal->oil_conductance_W_per_K;
+    const float k2 = cal->housing_conductance_W_per_K;
+    /* eq. 1 at rest: C dtheta/dt = 0 */
+    const float steady_degC = (power_W + k1 * theta_oil_degC + k2 * theta_housing_degC) / (k1 + k2);
+    /* eq. 1 exact ZOH step; the decay factor was computed at init */
+    const float next_degC = steady_degC + (theta_degC - steady_degC) * model->thermal_decay;
+    return (next_degC < WC_THETA_MIN_degC) ? WC_THETA_MIN_degC
+         : ((next_degC <= WC_THETA_MAX_degC) ? next_degC : WC_THETA_MAX_degC);
 }
 
 /* e^x within 2 ulp of expf on [-87, 88], in about a third of newlib's

@@ -183,6 +183,12 @@ wc_status_t wc_inverse(const wc_model_t *model, float slip_rad_s, float theta_de
 {
     WC_ASSERT((model != NULL) && (model->cal != NULL));
     WC_ASSERT(out != NULL);
+    if (out == NULL) { return WC_STATUS_NOT_INITIALISED; }
+    if ((model == NULL) || (model->cal == NULL)) {
+        const wc_inverse_t none = { 0.0f, 0.0f, 0.0f, 0u };
+        *out = none;  /* no calibration: no current */
+        return WC_STATUS_NOT_INITIALISED;
+    }
     wc_status_t status = WC_STATUS_OK;
     out->iterations = 0u;
     if (!wc_slip_valid(slip_rad_s)) { status |= WC_STATUS_SLIP_INVALID; }

@@ -46,6 +46,12 @@ wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_deg
 {
     WC_ASSERT((model != NULL) && (model->cal != NULL));
     WC_ASSERT(out != NULL);
+    if (out == NULL) { return WC_STATUS_NOT_INITIALISED; }
+    if ((model == NULL) || (model->cal == NULL)) {
+        const wc_torque_t none = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
+        *out = none;
+        return WC_STATUS_NOT_INITIALISED;
+    }
     wc_status_t status = WC_STATUS_OK;
     if (!wc_slip_valid(slip_rad_s)) { status |= WC_STATUS_SLIP_INVALID; }
     if (!wc_theta_valid(theta_degC)) { status |= WC_STATUS_THETA_INVALID; }

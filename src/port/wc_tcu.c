@@ -44,6 +44,7 @@ typedef struct {
     double idle_exit_s;       /* 0: never */
     double theta_start_degC;
     unsigned sensor_timeout, request_timeout;
+    int bench;                /* --bench: BenchMeasurement used (and passed by the kernel filter) */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -95,6 +96,8 @@ static void usage(FILE *out)
             "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
             "      --sensor-timeout N    ClutchSensors timeout in periods (default 10)\n"
             "      --request-timeout N   TorqueRequest timeout in periods (default 10)\n"
+            "  -b, --bench               use BenchMeasurement (0x130: load cell, torque sensor) as the\n"
+            "                            paper's validation does; off: the frame is filtered out\n"
             "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
             "  -h, --help\n");
 }
@@ -120,12 +123,13 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"steps", required_argument, NULL, 'n'},       {"idle-exit", required_argument, NULL, 'I'},
         {"theta-start", required_argument, NULL, 't'}, {"stats-json", required_argument, NULL, 'j'},
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
+        {"bench", no_argument, NULL, 'b'},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
     double v = 0.0;
     int c;
-    while ((c = getopt_long(argc, argv, "i:c:p:k:n:I:t:j:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "i:c:p:k:n:I:t:j:bh", longopts, NULL)) != -1) {
         switch (c) {
         case 'i': o->iface = optarg; break;
         case 'c':
@@ -139,6 +143,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'I': if (parse_number(optarg, "--idle-exit", 0.001, 1e6, &v)) { return -1; } o->idle_exit_s = v; break;
         case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
         case 'j': o->stats_json = optarg; break;
+        case 'b': o->bench = 1; break;
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; break;
         case 'h':
@@ -155,7 +160,8 @@ static int parse_options(int argc, char **argv, options_t *o)
 }
 
 /* Indexed by wc_loop_reject_t, in its order: a reason added without a name fails to compile. */
-static const char *const reject_names[] = {"crc", "counter", "short", "unknown_id", "format", "implausible", "overflow"};
+static const char *const reject_names[] = {"crc", "counter", "short", "unknown_id", "format", "implausible", "overflow",
+                                           "sync"};
 WC_STATIC_ASSERT(sizeof reject_names / sizeof reject_names[0] == WC_REJECT_REASONS, reject_names_cover_every_reason);
 
 static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, uint32_t rx_dropped,
@@ -202,7 +208,10 @@ int main(int argc, char **argv)
     }
     static wc_loop_t loop;  /* large (receive ring): static storage, not the stack */
     static step_times_t times;
-    const wc_loop_config_t config = {opt.sensor_timeout, opt.request_timeout};
+    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    config.sensor_timeout_periods = opt.sensor_timeout;
+    config.request_timeout_periods = opt.request_timeout;
+    config.bench_input_enabled = opt.bench != 0;
     const wc_cal_error_t cal_error = wc_loop_init(&loop, cal, &config, (float)opt.theta_start_degC);
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
@@ -220,12 +229,14 @@ int main(int argc, char **argv)
 
     wc_socketcan_t port;
     const uint32_t ids[] = WC_LOOP_RX_IDS;
-    if (wc_socketcan_open(&port, opt.iface, ids, WC_LOOP_RX_ID_COUNT) != 0) {
+    /* BenchMeasurement is last in WC_LOOP_RX_IDS: filtered out unless --bench. */
+    if (wc_socketcan_open(&port, opt.iface, ids, opt.bench ? WC_LOOP_RX_ID_COUNT : WC_LOOP_RX_ID_COUNT - 1u) != 0) {
         fprintf(stderr, "wc_tcu: %s\n", port.error);
         return 1;
     }
-    fprintf(stderr, "wc_tcu: %s, clock %s, period %lld us, calibration %s\n", opt.iface,
-            opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration);
+    fprintf(stderr, "wc_tcu: %s, clock %s, period %lld us, calibration %s%s\n", opt.iface,
+            opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration,
+            opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
     uint64_t tx_errors = 0;
     int status = 0;

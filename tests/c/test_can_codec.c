@@ -142,56 +142,109 @@ static void test_frame_crc_covers_data_id_and_bytes_1_to_7(void **state)
 
 /* ---- alive counter ------------------------------------------------------- */
 
+/* The receiver of wc_e2e.h (AUTOSAR E2E Profile 1 semantics), default
+ * parameters MaxDeltaCounter 2, SyncCounter 3. */
+static const wc_e2e_config_t e2e_default = { 2u, 3u };
+
+/* After a timeout: the reference and SyncCounter - 1 frames are SYNC, the
+ * SyncCounter-th in-sequence frame is the first OK. */
+static void receive_synced(wc_e2e_receiver_t *rx, uint8_t *counter)
+{
+    wc_e2e_receiver_restart(rx);
+    assert_int_equal(wc_e2e_receive(rx, &e2e_default, *counter), WC_E2E_STATUS_SYNC);
+    for (unsigned k = 1u; k < e2e_default.sync_counter; ++k) {
+        *counter = wc_e2e_counter_next(*counter);
+        assert_int_equal(wc_e2e_receive(rx, &e2e_default, *counter), WC_E2E_STATUS_SYNC);
+    }
+    *counter = wc_e2e_counter_next(*counter);
+    assert_int_equal(wc_e2e_receive(rx, &e2e_default, *counter), WC_E2E_STATUS_OK);
+}
+
 static void test_counter_sequence_and_wrap(void **state)
 {
-    wc_e2e_counter_state_t rx;
-    unsigned i;
+    wc_e2e_receiver_t rx;
     uint8_t counter = 13u;
 
     (void)state;
-    wc_e2e_counter_init(&rx);
-    /* first frame: accepted whatever its value */
-    assert_int_equal(wc_e2e_counter_check(&rx, counter), WC_E2E_COUNTER_INITIAL);
-    assert_true(wc_e2e_counter_accepted(WC_E2E_COUNTER_INITIAL));
-    /* 13, 14, 15, 0, 1, ... : wrap 15 -> 0 is a normal step */
-    for (i = 0u; i < 40u; ++i) {
+    /* after init the first frame is used at once */
+    wc_e2e_receiver_init(&rx);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_INITIAL);
+    assert_true(wc_e2e_status_usable(WC_E2E_STATUS_INITIAL));
+    counter = wc_e2e_counter_next(counter);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_OK);
+    receive_synced(&rx, &counter);
+    assert_false(wc_e2e_status_usable(WC_E2E_STATUS_SYNC));
+    assert_true(wc_e2e_status_usable(WC_E2E_STATUS_OK));
+    /* ..., 15, 0, 1, ... : wrap 15 -> 0 is a normal step */
+    for (unsigned i = 0u; i < 40u; ++i) {
         counter = wc_e2e_counter_next(counter);
-        assert_int_equal(wc_e2e_counter_check(&rx, counter), WC_E2E_COUNTER_OK);
+        assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_OK);
     }
     assert_int_equal(wc_e2e_counter_next(15u), 0u);
     assert_int_equal(wc_e2e_counter_next(0u), 1u);
-
-    /* explicit 15 -> 0 */
-    wc_e2e_counter_init(&rx);
-    assert_int_equal(wc_e2e_counter_check(&rx, 15u), WC_E2E_COUNTER_INITIAL);
-    assert_int_equal(wc_e2e_counter_check(&rx, 0u), WC_E2E_COUNTER_OK);
-    assert_int_equal(rx.previous, 0u);
+    /* the high nibble is ignored */
+    counter = wc_e2e_counter_next(counter);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, (uint8_t)(counter | 0xF0u)), WC_E2E_STATUS_OK);
 }
 
 static void test_counter_repeat_and_jump(void **state)
 {
-    wc_e2e_counter_state_t rx;
+    wc_e2e_receiver_t rx;
+    uint8_t counter = 4u;
 
     (void)state;
-    wc_e2e_counter_init(&rx);
-    assert_int_equal(wc_e2e_counter_check(&rx, 4u), WC_E2E_COUNTER_INITIAL);
-    /* repeated: dropped, reference kept */
-    assert_int_equal(wc_e2e_counter_check(&rx, 4u), WC_E2E_COUNTER_REPEATED);
-    assert_false(wc_e2e_counter_accepted(WC_E2E_COUNTER_REPEATED));
-    assert_int_equal(wc_e2e_counter_check(&rx, 5u), WC_E2E_COUNTER_OK);
-    /* one frame lost (6 missing): dropped, resynchronised to 7 */
-    assert_int_equal(wc_e2e_counter_check(&rx, 7u), WC_E2E_COUNTER_WRONG_SEQUENCE);
-    assert_false(wc_e2e_counter_accepted(WC_E2E_COUNTER_WRONG_SEQUENCE));
-    assert_int_equal(wc_e2e_counter_check(&rx, 8u), WC_E2E_COUNTER_OK);
-    /* going backwards is a jump too */
-    assert_int_equal(wc_e2e_counter_check(&rx, 7u), WC_E2E_COUNTER_WRONG_SEQUENCE);
-    assert_int_equal(wc_e2e_counter_check(&rx, 8u), WC_E2E_COUNTER_OK);
-    /* the high nibble is ignored */
-    assert_int_equal(wc_e2e_counter_check(&rx, 0xF9u), WC_E2E_COUNTER_OK);
-    /* after a timeout the caller re-inits: next frame is the reference */
-    wc_e2e_counter_init(&rx);
-    assert_int_equal(wc_e2e_counter_check(&rx, 2u), WC_E2E_COUNTER_INITIAL);
-    assert_int_equal(wc_e2e_counter_check(NULL, 3u), WC_E2E_COUNTER_WRONG_SEQUENCE);
+    receive_synced(&rx, &counter);   /* 4, 5, 6 SYNC, 7 OK */
+    /* repeated: no new data, reference kept */
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 7u), WC_E2E_STATUS_REPEATED);
+    assert_false(wc_e2e_status_usable(WC_E2E_STATUS_REPEATED));
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 8u), WC_E2E_STATUS_OK);
+    /* one frame lost (9 missing): used, OKSOMELOST; one lost frame costs one frame */
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 10u), WC_E2E_STATUS_OKSOMELOST);
+    assert_true(wc_e2e_status_usable(WC_E2E_STATUS_OKSOMELOST));
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 11u), WC_E2E_STATUS_OK);
+    /* two lost (delta 3 > MaxDeltaCounter): wrong sequence, then SyncCounter frames */
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 14u), WC_E2E_STATUS_WRONGSEQUENCE);
+    assert_false(wc_e2e_status_usable(WC_E2E_STATUS_WRONGSEQUENCE));
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 15u), WC_E2E_STATUS_SYNC);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 0u), WC_E2E_STATUS_SYNC);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 1u), WC_E2E_STATUS_OK);
+    /* going backwards is a wrong sequence too */
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, 0u), WC_E2E_STATUS_WRONGSEQUENCE);
+    /* NULL: never usable */
+    assert_int_equal(wc_e2e_receive(NULL, &e2e_default, 3u), WC_E2E_STATUS_WRONGSEQUENCE);
+    assert_int_equal(wc_e2e_receive(&rx, NULL, 3u), WC_E2E_STATUS_WRONGSEQUENCE);
+    /* MaxDeltaCounter 0: no lost frame tolerated (a +2 is a wrong sequence) */
+    const wc_e2e_config_t strict = { 0u, 3u };
+    uint8_t c = 0u;
+    receive_synced(&rx, &c);
+    assert_int_equal(wc_e2e_receive(&rx, &strict, (uint8_t)(c + 2u)), WC_E2E_STATUS_WRONGSEQUENCE);
+}
+
+/* A frozen sender (same counter forever) and a sender counting +2 every
+ * frame: after their first frame neither delivers usable data again. */
+static void test_counter_frozen_and_fixed_pattern(void **state)
+{
+    (void)state;
+    wc_e2e_receiver_t rx;
+    uint8_t counter = 9u;
+    receive_synced(&rx, &counter);
+    for (unsigned i = 0u; i < 100u; ++i) {
+        assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_REPEATED);
+    }
+    /* the same after the timeout restarts the receiver */
+    wc_e2e_receiver_restart(&rx);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_SYNC);
+    for (unsigned i = 0u; i < 100u; ++i) {
+        assert_false(wc_e2e_status_usable(wc_e2e_receive(&rx, &e2e_default, counter)));
+    }
+    /* +2 every frame: the first jump is one lost frame (used), then never again */
+    receive_synced(&rx, &counter);
+    counter = (uint8_t)((counter + 2u) & 0x0Fu);
+    assert_int_equal(wc_e2e_receive(&rx, &e2e_default, counter), WC_E2E_STATUS_OKSOMELOST);
+    for (unsigned i = 0u; i < 100u; ++i) {
+        counter = (uint8_t)((counter + 2u) & 0x0Fu);
+        assert_false(wc_e2e_status_usable(wc_e2e_receive(&rx, &e2e_default, counter)));
+    }
 }
 
 /* ---- rounding ------------------------------------------------------------ */
@@ -541,9 +594,10 @@ static void test_round_trip_vfs_command(void **state)
     assert_int_equal(wc_can_decode_vfs_command(&out, frame, sizeof frame), WC_CAN_OK);
     assert_float_equal(out.vfs_current_mA, 157.8125f, 0.0f); /* nearest 1/32 */
     assert_float_equal(out.pressure_command_kPa, 363.0f, 0.0f);
-    /* reserved status bits 10..15 are not sent */
+    /* reserved status bits (above WC_CAN_STATUS_BITS: 14, 15) are not sent */
     assert_int_equal(out.status, WC_CAN_STATUS_DEFINED_MASK);
-    assert_int_equal(frame[7] & 0xFCu, 0u);
+    assert_int_equal(WC_CAN_STATUS_DEFINED_MASK, 0x3FFFu);
+    assert_int_equal(frame[7] & 0xC0u, 0u);
     assert_int_equal(frame[1] & 0xF0u, 0u);
     /* each status bit on its own */
     for (bit = 0u; bit < 16u; ++bit) {
@@ -699,6 +753,7 @@ int main(void)
         cmocka_unit_test(test_frame_crc_covers_data_id_and_bytes_1_to_7),
         cmocka_unit_test(test_counter_sequence_and_wrap),
         cmocka_unit_test(test_counter_repeat_and_jump),
+        cmocka_unit_test(test_counter_frozen_and_fixed_pattern),
         cmocka_unit_test(test_rounding_at_step_boundaries_binary_scale),
         cmocka_unit_test(test_rounding_decimal_scale_and_offset),
         cmocka_unit_test(test_saturation_at_both_ends),

@@ -281,10 +281,15 @@ static void fixture_init_with(fixture_t *fx, const wc_loop_config_t *config)
     port_reset();
 }
 
+/* The default configuration with a recovery debounce of one period: the
+ * tests of steady behaviour see control from the first pair of frames. The
+ * debounce, SyncCounter and the fault matrix use WC_LOOP_CONFIG_DEFAULT
+ * itself (tests/c/test_loop_faults.c). */
+static const wc_loop_config_t config_no_debounce = { 10u, 10u, { 2u, 3u }, 1u, false };
+
 static void fixture_init(fixture_t *fx)
 {
-    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
-    fixture_init_with(fx, &config);
+    fixture_init_with(fx, &config_no_debounce);
 }
 
 static int setup(void **state)
@@ -425,6 +430,22 @@ static void good_request(fixture_t *fx, float torque_Nm, uint8_t mode)
     const wc_can_frame_t f = request_frame(torque_Nm, mode, fx->request_alive);
     fx->request_alive = wc_e2e_counter_next(fx->request_alive);
     assert_int_equal(wc_can_decode_torque_request(&fx->ref.request, f.data, f.dlc), WC_CAN_OK);
+    port_deliver(&f);
+}
+
+/* A valid frame with the next counter that the loop must NOT use (its E2E
+ * receiver is synchronising: wc_e2e.h SYNC); the reference keeps its values. */
+static void sync_sensors(fixture_t *fx, float slip_rpm, float oil_degC, float housing_degC)
+{
+    const wc_can_frame_t f = sensors_frame(slip_rpm, oil_degC, housing_degC, fx->sensors_alive);
+    fx->sensors_alive = wc_e2e_counter_next(fx->sensors_alive);
+    port_deliver(&f);
+}
+
+static void sync_request(fixture_t *fx, float torque_Nm, uint8_t mode)
+{
+    const wc_can_frame_t f = request_frame(torque_Nm, mode, fx->request_alive);
+    fx->request_alive = wc_e2e_counter_next(fx->request_alive);
     port_deliver(&f);
 }
 
@@ -637,8 +658,8 @@ static void check_min_current(void)
 
 /* ClutchSensors stop (the request goes on; timer deadlines step the loop):
  * fresh for timeout-1 periods, then SensorTimeout + SafeStateActive and the
- * minimum current; one timeout counted. The first valid frame afterwards,
- * with any counter, ends it. */
+ * minimum current; one timeout counted. Recovery needs the reference frame
+ * and SyncCounter - 1 more in sequence, then the next frame is used. */
 static void sensor_timeout_case(fixture_t *fx, const wc_loop_config_t *config)
 {
     fixture_init_with(fx, config);
@@ -660,18 +681,31 @@ static void sensor_timeout_case(fixture_t *fx, const wc_loop_config_t *config)
     assert_int_equal(fx->loop.counters.request_timeouts, 0u);
 
     /* Recovery: the sender restarts with a counter 7 ahead of the old
-     * sequence; it is the new reference, not a counter error. */
+     * sequence. Its first frame is the new reference and the next
+     * SyncCounter - 1 are in sequence but not yet used (wc_e2e.h SYNC, no
+     * counter error): the input stays stale; the SyncCounter-th +1 frame is
+     * used and, with this fixture's one-period debounce, control resumes. */
     fx->sensors_alive = (uint8_t)((fx->sensors_alive + 7u) % WC_E2E_COUNTER_MODULO);
     const period_t back = { 900.0f, 70.0f, 60.0f, 150.0f, MODE_TORQUE };
+    for (uint32_t k = 0u; k < config->e2e.sync_counter; ++k) {
+        good_request(fx, back.torque_Nm, back.mode);
+        sync_sensors(fx, back.slip_rpm, back.oil_degC, back.housing_degC);
+        run_steps(&fx->loop, 1u);
+        const expected_t e = ref_step(&fx->ref, true);
+        check_step(fx, &e, SAFE_SENSORS);
+        check_min_current();
+    }
     (void)good_period(fx, &back, 0u);
     (void)good_period(fx, &back, 0u);
-    check_rejected_only(&fx->loop, WC_REJECT_COUNTER, 0u);
+    check_rejected_only(&fx->loop, WC_REJECT_SYNC, config->e2e.sync_counter);
     assert_int_equal(fx->loop.counters.sensor_timeouts, 1u);
-    assert_int_equal(fx->loop.counters.safe_steps, stale_periods);
+    assert_int_equal(fx->loop.counters.safe_steps, stale_periods + config->e2e.sync_counter);
 }
 
 /* Timeouts of the default configuration and two others (sensor, request). */
-static const wc_loop_config_t timeout_configs[] = { WC_LOOP_CONFIG_DEFAULT, { 3u, 25u }, { 1u, 1u } };
+static const wc_loop_config_t timeout_configs[] = {
+    { 10u, 10u, { 2u, 3u }, 1u, false }, { 3u, 25u, { 2u, 1u }, 1u, false }, { 1u, 1u, { 2u, 2u }, 1u, false }
+};
 
 static void test_sensor_timeout_and_recovery(void **state)
 {
@@ -699,11 +733,19 @@ static void request_timeout_case(fixture_t *fx, const wc_loop_config_t *config)
 
     fx->request_alive = (uint8_t)((fx->request_alive + 11u) % WC_E2E_COUNTER_MODULO);
     const period_t back = { 500.0f, 60.0f, 55.0f, 220.0f, MODE_TORQUE };
+    for (uint32_t k = 0u; k < config->e2e.sync_counter; ++k) {  /* reference + SYNC frames: not used */
+        sync_request(fx, back.torque_Nm, back.mode);
+        good_sensors(fx, NOMINAL.slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC);
+        run_steps(&fx->loop, 1u);
+        const expected_t e = ref_step(&fx->ref, true);
+        check_step(fx, &e, SAFE_REQUEST);
+        check_min_current();
+    }
     (void)good_period(fx, &back, 0u);
     (void)good_period(fx, &back, 0u);
-    check_rejected_only(&fx->loop, WC_REJECT_COUNTER, 0u);
+    check_rejected_only(&fx->loop, WC_REJECT_SYNC, config->e2e.sync_counter);
     assert_int_equal(fx->loop.counters.request_timeouts, 1u);
-    assert_int_equal(fx->loop.counters.safe_steps, stale_periods);
+    assert_int_equal(fx->loop.counters.safe_steps, stale_periods + config->e2e.sync_counter);
 }
 
 static void test_request_timeout_and_recovery(void **state)
@@ -753,9 +795,12 @@ static void test_safe_state_before_first_frames(void **state)
 /* E2E and format rejections                                                */
 /* ======================================================================== */
 
-/* A repeated and a jumping alive counter, on each input: the frame (which
- * carries a different value) is not used, it is counted, and
- * StatusCounterError is in the VfsCommand of that step only. */
+/* A repeated and a jumping alive counter (3 or 5 ahead: more than one lost
+ * frame), on each input: the frame (which carries a different value) is not
+ * used, it is counted, and StatusCounterError is in the VfsCommand of that
+ * step only. After a jump the sender's next SyncCounter - 1 frames are in
+ * sequence but not yet used (SYNC, no error bit, the input is still fresh:
+ * no safe state); the one after is used. */
 static void test_counter_repeat_and_jump(void **state)
 {
     fixture_t *fx = *state;
@@ -779,9 +824,19 @@ static void test_counter_repeat_and_jump(void **state)
         const expected_t e = ref_step(&fx->ref, false);  /* held sensors */
         check_step(fx, &e, WC_CAN_STATUS_COUNTER_ERROR);
         check_held(fx);
-        check_rejected_only(&fx->loop, WC_REJECT_COUNTER, bad);
+        assert_int_equal(fx->loop.counters.rejected[WC_REJECT_COUNTER], bad);
         /* A repeat leaves the reference; a jump resynchronises to it. */
-        if (jump) { fx->sensors_alive = wc_e2e_counter_next(bad_counter); }
+        if (jump) {
+            fx->sensors_alive = wc_e2e_counter_next(bad_counter);
+            for (int k = 1; k < 3; ++k) {  /* SyncCounter 3: two more frames not used */
+                good_request(fx, NOMINAL.torque_Nm, NOMINAL.mode);
+                sync_sensors(fx, other_slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC);
+                run_steps(&fx->loop, 1u);
+                const expected_t s_e = ref_step(&fx->ref, false);  /* held sensors */
+                check_step(fx, &s_e, 0u);
+                check_held(fx);
+            }
+        }
         (void)good_period(fx, &NOMINAL, 0u);  /* next VfsCommand: bit gone */
         (void)good_period(fx, &NOMINAL, 0u);
     }
@@ -800,18 +855,29 @@ static void test_counter_repeat_and_jump(void **state)
         const expected_t e = ref_step(&fx->ref, false);  /* held request */
         check_step(fx, &e, WC_CAN_STATUS_COUNTER_ERROR);
         check_held(fx);
-        check_rejected_only(&fx->loop, WC_REJECT_COUNTER, bad);
-        if (jump) { fx->request_alive = wc_e2e_counter_next(bad_counter); }
+        assert_int_equal(fx->loop.counters.rejected[WC_REJECT_COUNTER], bad);
+        if (jump) {
+            fx->request_alive = wc_e2e_counter_next(bad_counter);
+            for (int k = 1; k < 3; ++k) {
+                sync_request(fx, other_torque_Nm, MODE_TORQUE);
+                good_sensors(fx, NOMINAL.slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC);
+                run_steps(&fx->loop, 1u);
+                const expected_t s_e = ref_step(&fx->ref, false);  /* held request */
+                check_step(fx, &s_e, 0u);
+                check_held(fx);
+            }
+        }
         (void)good_period(fx, &NOMINAL, 0u);
         (void)good_period(fx, &NOMINAL, 0u);
     }
     assert_int_equal(fx->loop.counters.safe_steps, 0u);
+    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_SYNC], 4u);  /* 2 per jump */
 }
 
 /* One flipped bit: the CRC fails, the frame is not used, StatusCrcError in
  * that step's VfsCommand only. The sender's counter went on with the lost
- * frame, so its next frame is a jump and is dropped too (wc_e2e.h: "one lost
- * frame costs one more"); the one after is used. */
+ * frame, so its next frame is one ahead of the expected one: OKSOMELOST,
+ * used (wc_e2e.h: one lost frame costs one frame), no counter error. */
 static void test_crc_error(void **state)
 {
     fixture_t *fx = *state;
@@ -829,18 +895,12 @@ static void test_crc_error(void **state)
     check_held(fx);
     check_rejected_only(&fx->loop, WC_REJECT_CRC, 1u);
 
-    good_request(fx, NOMINAL.torque_Nm, NOMINAL.mode);
-    const wc_can_frame_t next = sensors_frame(1500.0f, NOMINAL.oil_degC, NOMINAL.housing_degC, fx->sensors_alive);
-    fx->sensors_alive = wc_e2e_counter_next(fx->sensors_alive);
-    port_deliver(&next);
-    run_steps(&fx->loop, 1u);
-    e = ref_step(&fx->ref, false);
-    check_step(fx, &e, WC_CAN_STATUS_COUNTER_ERROR);
-    check_held(fx);
+    const period_t after = { 1500.0f, NOMINAL.oil_degC, NOMINAL.housing_degC, NOMINAL.torque_Nm, NOMINAL.mode };
+    (void)good_period(fx, &after, 0u);   /* used at once */
     (void)good_period(fx, &NOMINAL, 0u);
 
     /* TorqueRequest: bit 0 of byte 3 (TorqueRequest high byte), then the
-     * sender's next frame (a jump: dropped), then one that is used. */
+     * sender's next frame, used at once. */
     const period_t more = { NOMINAL.slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC, 300.0f, MODE_TORQUE };
     f = request_frame(more.torque_Nm, more.mode, fx->request_alive);
     fx->request_alive = wc_e2e_counter_next(fx->request_alive);
@@ -853,21 +913,15 @@ static void test_crc_error(void **state)
     check_held(fx);
     assert_int_equal(fx->loop.counters.rejected[WC_REJECT_CRC], 2u);
 
-    const wc_can_frame_t q = request_frame(more.torque_Nm, more.mode, fx->request_alive);
-    fx->request_alive = wc_e2e_counter_next(fx->request_alive);
-    port_deliver(&q);
-    good_sensors(fx, NOMINAL.slip_rpm, NOMINAL.oil_degC, NOMINAL.housing_degC);
-    run_steps(&fx->loop, 1u);
-    e = ref_step(&fx->ref, false);
-    check_step(fx, &e, WC_CAN_STATUS_COUNTER_ERROR);
-    check_held(fx);
+    (void)good_period(fx, &more, 0u);   /* the sender's next frame: used at once */
     (void)good_period(fx, &more, 0u);
     assert_int_equal(fx->loop.counters.rejected[WC_REJECT_CRC], 2u);
-    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_COUNTER], 2u);
-    assert_int_equal(rejected_total(&fx->loop.counters), 4u);
+    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_COUNTER], 0u);
+    assert_int_equal(rejected_total(&fx->loop.counters), 2u);
 }
 
-/* Short frame, unknown id and wrong format (extended, remote, error): not
+/* Short frame, unknown id and wrong format (extended, remote, error), each
+ * raising StatusFrameLost in the step that processed it: not
  * used, counted by reason. These frames are built with the counter the next
  * good frame carries as well: a frame that never reaches the counter check
  * must not consume it. */
@@ -883,7 +937,7 @@ static void test_short_unknown_and_format(void **state)
     port_deliver(&f);
     run_steps(&fx->loop, 1u);
     expected_t e = ref_step(&fx->ref, false);
-    check_step(fx, &e, 0u);
+    check_step(fx, &e, WC_CAN_STATUS_FRAME_LOST);  /* lost before its check: StatusFrameLost, that step only */
     check_held(fx);
     check_rejected_only(&fx->loop, WC_REJECT_SHORT, 1u);
     (void)good_period(fx, &NOMINAL, 0u);
@@ -900,6 +954,7 @@ static void test_short_unknown_and_format(void **state)
     wc_can_frame_t stranger = sensors_frame(1500.0f, 90.0f, 80.0f, fx->sensors_alive);
     stranger.id = 0x7FFu;
     port_deliver(&stranger);
+    (void)good_period(fx, &NOMINAL, WC_CAN_STATUS_FRAME_LOST);
     (void)good_period(fx, &NOMINAL, 0u);
     assert_int_equal(fx->loop.counters.rejected[WC_REJECT_UNKNOWN_ID], 3u);
     assert_int_equal(rejected_total(&fx->loop.counters), 1u + 3u);
@@ -914,7 +969,7 @@ static void test_short_unknown_and_format(void **state)
         q.flags = flags[i];
         port_deliver(&q);
         port_deliver(&s);  /* flagged: no step */
-        (void)good_period(fx, &NOMINAL, 0u);
+        (void)good_period(fx, &NOMINAL, WC_CAN_STATUS_FRAME_LOST);
         check_held(fx);
     }
     assert_int_equal(fx->loop.counters.rejected[WC_REJECT_FORMAT], 2u * WC_TEST_COUNT(flags));
@@ -1072,14 +1127,21 @@ static void test_persistent_implausible_sensor(void **state)
         port_deliver(&f);
         run_steps(&fx->loop, 1u);
         const bool stale = (j >= timeout);
+        /* The timeout (period `timeout`) restarts the E2E receiver: the next
+         * SyncCounter frames are the reference and in-sequence SYNC frames,
+         * whose plausibility is not looked at; after them, implausible again. */
+        const bool syncing = (j > timeout) && (j <= timeout + fx->loop.config.e2e.sync_counter);
         const expected_t e = ref_step(&fx->ref, stale);
-        check_step(fx, &e, (uint16_t)(WC_CAN_STATUS_IMPLAUSIBLE_INPUT | (stale ? SAFE_SENSORS : 0u)));
+        check_step(fx, &e, (uint16_t)((syncing ? 0u : WC_CAN_STATUS_IMPLAUSIBLE_INPUT) | (stale ? SAFE_SENSORS : 0u)));
         if (stale) { check_min_current(); }
         check_held(fx);
         WC_CHECK(fx->loop.counters.sensor_timeouts == (stale ? 1u : 0u), "period %u: %u sensor timeouts",
                  (unsigned)j, (unsigned)fx->loop.counters.sensor_timeouts);
     }
-    check_rejected_only(&fx->loop, WC_REJECT_IMPLAUSIBLE, timeout + stale_periods - 1u);
+    const uint32_t sync = fx->loop.config.e2e.sync_counter;
+    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_IMPLAUSIBLE], timeout + stale_periods - 1u - sync);
+    assert_int_equal(fx->loop.counters.rejected[WC_REJECT_SYNC], sync);
+    /* the implausible frames were in sequence: the receiver is synchronised, the next good frame is used */
     (void)good_period(fx, &NOMINAL, 0u);
     (void)good_period(fx, &NOMINAL, 0u);
     assert_int_equal(fx->loop.counters.safe_steps, stale_periods);
@@ -1288,6 +1350,9 @@ static void check_model_torque_at(const fixture_t *fx, long k, float force_N)
 static void test_bench_force_replaces_modelled_force(void **state)
 {
     fixture_t *fx = *state;
+    wc_loop_config_t bench_config = config_no_debounce;
+    bench_config.bench_input_enabled = true;  /* wc_tcu --bench */
+    fixture_init_with(fx, &bench_config);
     const wc_calibration_t *cal = &wc_table1_calibration;
     for (int k = 0; k < 5; ++k) { bench_period(fx, NULL); }
     const float load_N = 1188.0f;
@@ -1326,8 +1391,10 @@ static void test_bench_force_replaces_modelled_force(void **state)
         wc_can_vfs_command_phys_t cmd;
         wc_can_clutch_estimate_phys_t est;
         last_outputs(&cmd, &est);
-        WC_CHECK((cmd.status & (WC_CAN_STATUS_SAFE_STATE_ACTIVE | WC_CAN_STATUS_IMPLAUSIBLE_INPUT)) == 0u,
-                 "bench staleness must not raise a fault (status 0x%x)", (unsigned)cmd.status);
+        WC_CHECK((cmd.status & (WC_CAN_STATUS_SAFE_STATE_ACTIVE | WC_CAN_STATUS_IMPLAUSIBLE_INPUT |
+                                WC_CAN_STATUS_BENCH_INPUT)) == 0u,
+                 "bench staleness must not raise a fault, and the bench is no longer used (status 0x%x)",
+                 (unsigned)cmd.status);
     }
     assert_int_equal(fx->loop.counters.rejected[WC_REJECT_UNKNOWN_ID], 0u);
 }

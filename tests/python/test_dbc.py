@@ -45,7 +45,8 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
     "StatusSensorTimeout", "StatusRequestTimeout", "StatusCrcError",
     "StatusCounterError", "StatusImplausibleInput", "StatusSaturated",
     "StatusCurrentClamped", "StatusBelowDrag", "StatusSafeStateActive",
-    "StatusDeadlineMiss",
+    "StatusDeadlineMiss", "StatusOverTemperature", "StatusBenchInput",
+    "StatusFrameLost", "StatusBusError",
 ]
 # Integer signals that the scaling wrapper does not convert.
 UNSCALED = {"Crc", "AliveCounter", "Mode", *STATUS_BITS}

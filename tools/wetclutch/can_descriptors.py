@@ -281,10 +281,17 @@ def _decode(m: Message) -> str:
         lines.append(f"    if (!{PREFIX}_{m.snake}_{s.snake}_is_in_range(msg.{s.snake})) {{")
         lines.append("        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);")
         lines.append("    }")
-    for s in m.of("status"):
-        lines.append(f"    status |= (uint32_t)(msg.{s.snake} & 1u) << {s.bit};")
-    if m.of("status"):
-        lines.append("    dst->status = (uint16_t)status;")
+    status = m.of("status")
+    if status:
+        # The contiguous little-endian status bits, read as one word (the mirror of encode).
+        mask = (1 << len(status)) - 1
+        shift = m.status_start % 8
+        first_byte = m.status_start // 8
+        last_byte = (m.status_start + len(status) - 1) // 8
+        for b in range(first_byte, last_byte + 1):
+            lines.append(f"    status |= (uint32_t)src[{b}] << {8 * (b - first_byte)};")
+        lines.append(f"    dst->status = (uint16_t)((status >> {shift}) & 0x{mask:X}u);"
+                     f"  /* frame bits {m.status_start}..{m.status_start + len(status) - 1} */")
     if m.e2e:
         lines.append("    dst->alive_counter = msg.alive_counter;")
     lines += ["    return result;", "}"]

@@ -341,6 +341,10 @@ int wc_can_vfs_command_pack(
     dst_p[6] |= pack_left_shift_u8(src_p->status_below_drag, 7u, 0x80u);
     dst_p[7] |= pack_left_shift_u8(src_p->status_safe_state_active, 0u, 0x01u);
     dst_p[7] |= pack_left_shift_u8(src_p->status_deadline_miss, 1u, 0x02u);
+    dst_p[7] |= pack_left_shift_u8(src_p->status_over_temperature, 2u, 0x04u);
+    dst_p[7] |= pack_left_shift_u8(src_p->status_bench_input, 3u, 0x08u);
+    dst_p[7] |= pack_left_shift_u8(src_p->status_frame_lost, 4u, 0x10u);
+    dst_p[7] |= pack_left_shift_u8(src_p->status_bus_error, 5u, 0x20u);
 
     return (8);
 }
@@ -370,6 +374,10 @@ int wc_can_vfs_command_unpack(
     dst_p->status_below_drag = unpack_right_shift_u8(src_p[6], 7u, 0x80u);
     dst_p->status_safe_state_active = unpack_right_shift_u8(src_p[7], 0u, 0x01u);
     dst_p->status_deadline_miss = unpack_right_shift_u8(src_p[7], 1u, 0x02u);
+    dst_p->status_over_temperature = unpack_right_shift_u8(src_p[7], 2u, 0x04u);
+    dst_p->status_bench_input = unpack_right_shift_u8(src_p[7], 3u, 0x08u);
+    dst_p->status_frame_lost = unpack_right_shift_u8(src_p[7], 4u, 0x10u);
+    dst_p->status_bus_error = unpack_right_shift_u8(src_p[7], 5u, 0x20u);
 
     return (0);
 }
@@ -521,6 +529,46 @@ bool wc_can_vfs_command_status_deadline_miss_is_in_range(uint8_t value)
 }
 
 bool wc_can_vfs_command_status_deadline_miss_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_vfs_command_status_over_temperature_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_vfs_command_status_over_temperature_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_vfs_command_status_bench_input_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_vfs_command_status_bench_input_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_vfs_command_status_frame_lost_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_vfs_command_status_frame_lost_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_vfs_command_status_bus_error_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_vfs_command_status_bus_error_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 1.0f));
 }

@@ -184,7 +184,7 @@ wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command
     if (wc_can_vfs_command_pack(dst, &msg, size) < 0) {
         return WC_CAN_ERR_SIZE;
     }
-    const uint32_t status_bits = ((uint32_t)src->status & 0x3FFu) << 0;  /* frame bits 48..57 */
+    const uint32_t status_bits = ((uint32_t)src->status & 0x3FFFu) << 0;  /* frame bits 48..61 */
     dst[6] = (uint8_t)(dst[6] | (uint8_t)(status_bits >> 0));
     dst[7] = (uint8_t)(dst[7] | (uint8_t)(status_bits >> 8));
     (void)wc_e2e_protect(WC_CAN_VFS_COMMAND_FRAME_ID, dst, size);
@@ -208,17 +208,9 @@ wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const 
     }
     dst->vfs_current_mA = to_phys(&wc_can_sig_vfs_command_vfs_current, msg.vfs_current, &result);
     dst->pressure_command_kPa = to_phys(&wc_can_sig_vfs_command_pressure_command, msg.pressure_command, &result);
-    status |= (uint32_t)(msg.status_sensor_timeout & 1u) << 0;
-    status |= (uint32_t)(msg.status_request_timeout & 1u) << 1;
-    status |= (uint32_t)(msg.status_crc_error & 1u) << 2;
-    status |= (uint32_t)(msg.status_counter_error & 1u) << 3;
-    status |= (uint32_t)(msg.status_implausible_input & 1u) << 4;
-    status |= (uint32_t)(msg.status_saturated & 1u) << 5;
-    status |= (uint32_t)(msg.status_current_clamped & 1u) << 6;
-    status |= (uint32_t)(msg.status_below_drag & 1u) << 7;
-    status |= (uint32_t)(msg.status_safe_state_active & 1u) << 8;
-    status |= (uint32_t)(msg.status_deadline_miss & 1u) << 9;
-    dst->status = (uint16_t)status;
+    status |= (uint32_t)src[6] << 0;
+    status |= (uint32_t)src[7] << 8;
+    dst->status = (uint16_t)((status >> 0) & 0x3FFFu);  /* frame bits 48..61 */
     dst->alive_counter = msg.alive_counter;
     return result;
 }
