@@ -175,8 +175,8 @@ static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx
         fprintf(out, "  \"rejected\": {");
         for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, "%s\"%s\": %u", r ? ", " : "", reject_names[r], k->rejected[r]); }
         fprintf(out, "},\n  \"sensor_timeouts\": %u,\n  \"request_timeouts\": %u,\n  \"safe_steps\": %u,\n"
-                     "  \"steps\": %u,\n  \"deadline_misses\": %u,\n",
-                k->sensor_timeouts, k->request_timeouts, k->safe_steps, k->steps, k->deadline_misses);
+                     "  \"steps\": %u,\n  \"deadline_misses\": %u,\n  \"bus_errors\": %u,\n",
+                k->sensor_timeouts, k->request_timeouts, k->safe_steps, k->steps, k->deadline_misses, k->bus_errors);
         fprintf(out, "  \"step_time_us\": {\"max\": %.3f, \"p50\": %.3f, \"p90\": %.3f, \"p99\": %.3f, \"p99.9\": %.3f}\n}\n",
                 (double)h->max_ns / 1000.0, percentile_us(h, 50), percentile_us(h, 90), percentile_us(h, 99),
                 percentile_us(h, 99.9));
@@ -186,26 +186,108 @@ static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx
             k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors, rx_dropped);
     fprintf(out, "wc_tcu: rejected:");
     for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, " %s %u", reject_names[r], k->rejected[r]); }
-    fprintf(out, "\nwc_tcu: timeouts: sensors %u, request %u; steps %u (safe state %u); deadline misses %u\n",
-            k->sensor_timeouts, k->request_timeouts, k->steps, k->safe_steps, k->deadline_misses);
+    fprintf(out, "\nwc_tcu: timeouts: sensors %u, request %u; steps %u (safe state %u); deadline misses %u;"
+                 " bus errors and failed sends %u\n",
+            k->sensor_timeouts, k->request_timeouts, k->steps, k->safe_steps, k->deadline_misses, k->bus_errors);
     fprintf(out, "wc_tcu: step time (loop step + send) max %.1f us", (double)h->max_ns / 1000.0);
     for (size_t i = 0; i < sizeof pct / sizeof pct[0]; ++i) { fprintf(out, ", p%g %.1f us", pct[i], percentile_us(h, pct[i])); }
     fprintf(out, "\n");
+}
+
+static const wc_calibration_t *find_calibration(const char *name)
+{
+    for (size_t i = 0; i < wc_tcu_calibration_count; ++i) {
+        if (strcmp(name, wc_tcu_calibrations[i].name) == 0) { return wc_tcu_calibrations[i].calibration; }
+    }
+    fprintf(stderr, "wc_tcu: --calibration: '%s' is not compiled in (wc_tcu --help lists them); generate its"
+                    " headers with `wetclutch lut` and add it to src/port/wc_tcu_calibrations.c\n", name);
+    return NULL;
+}
+
+/* Everything the main loop counts besides the loop's own counters. */
+typedef struct {
+    uint64_t tx_errors;
+    uint32_t rx_dropped_seen;  /* port->rx_dropped already reported to the loop */
+} port_stats_t;
+
+/* The main loop until a signal, --steps or --idle-exit: wait for a frame or
+ * the deadline, one wc_loop_iterate, send what it produced. The port's
+ * kernel drops and failed sends are reported to the loop as they happen
+ * (StatusFrameLost / StatusBusError in the next VfsCommand). Returns the
+ * exit status. */
+static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step_times_t *times, port_stats_t *ps)
+{
+    int64_t last_rx = -1;  /* the idle timer starts with the first frame */
+    int64_t deadline = now_ns() + opt->period_ns;
+    const wc_loop_clock_t clock = opt->frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
+    while (!stop_requested && (opt->max_steps == 0 || loop->counters.steps < opt->max_steps)) {
+        wc_can_frame_t frame;
+        const int64_t wait_ns = opt->frame_clock ? 100000000LL : deadline - now_ns();
+        const int got = (wait_ns > 0) ? wc_socketcan_receive(port, &frame, wait_ns / 1000) : 0;
+        if (got < 0) {
+            fprintf(stderr, "wc_tcu: %s\n", port->error);
+            return 1;
+        }
+        if (port->rx_dropped != ps->rx_dropped_seen) {
+            wc_loop_port_event(loop, WC_LOOP_PORT_RX_DROPPED, port->rx_dropped - ps->rx_dropped_seen);
+            ps->rx_dropped_seen = port->rx_dropped;
+        }
+        const int64_t t = now_ns();
+        if (got == 1) {
+            last_rx = t;
+        } else if (opt->idle_exit_s > 0 && last_rx >= 0 && (double)(t - last_rx) > opt->idle_exit_s * 1e9) {
+            return 0;
+        }
+        bool tick = false;
+        if (!opt->frame_clock && t >= deadline) {
+            tick = true;
+            deadline += opt->period_ns;
+            if (t >= deadline) {  /* late by a whole period or more: skip, count */
+                const int64_t missed = (t - deadline) / opt->period_ns + 1;
+                deadline += missed * opt->period_ns;
+                wc_loop_deadline_missed(loop, (uint32_t)missed);
+            }
+        }
+        const int64_t t0 = now_ns();
+        wc_can_frame_t out[WC_LOOP_TX_FRAMES];
+        const uint32_t n = wc_loop_iterate(loop, clock, (got == 1) ? &frame : NULL, tick, out);
+        if (n == 0u) { continue; }
+        for (uint32_t i = 0; i < n; ++i) {
+            if (wc_socketcan_send(port, &out[i]) != 0) {
+                if (ps->tx_errors == 0) {
+                    fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port->error);
+                }
+                ps->tx_errors++;
+                wc_loop_port_event(loop, WC_LOOP_PORT_TX_FAILED, 1u);
+            }
+        }
+        record(times, now_ns() - t0);
+    }
+    return 0;
+}
+
+static int write_stats_json(const char *path, const wc_loop_counters_t *counters, const port_stats_t *ps,
+                            uint32_t rx_dropped, const step_times_t *times)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        fprintf(stderr, "wc_tcu: cannot write %s: %s\n", path, strerror(errno));
+        return 1;
+    }
+    report(f, 1, counters, ps->tx_errors, rx_dropped, times);
+    if (fclose(f) != 0) {
+        fprintf(stderr, "wc_tcu: cannot write %s: %s\n", path, strerror(errno));
+        return 1;
+    }
+    return 0;
 }
 
 int main(int argc, char **argv)
 {
     options_t opt;
     if (parse_options(argc, argv, &opt) != 0) { return 2; }
-    const wc_calibration_t *cal = NULL;
-    for (size_t i = 0; i < wc_tcu_calibration_count; ++i) {
-        if (strcmp(opt.calibration, wc_tcu_calibrations[i].name) == 0) { cal = wc_tcu_calibrations[i].calibration; }
-    }
-    if (cal == NULL) {
-        fprintf(stderr, "wc_tcu: --calibration: '%s' is not compiled in (wc_tcu --help lists them); generate its"
-                        " headers with `wetclutch lut` and add it to src/port/wc_tcu_calibrations.c\n", opt.calibration);
-        return 2;
-    }
+    const wc_calibration_t *cal = find_calibration(opt.calibration);
+    if (cal == NULL) { return 2; }
     static wc_loop_t loop;  /* large (receive ring): static storage, not the stack */
     static step_times_t times;
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
@@ -238,61 +320,12 @@ int main(int argc, char **argv)
             opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration,
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
-    uint64_t tx_errors = 0;
-    int status = 0;
-    int64_t last_rx = -1;  /* the idle timer starts with the first frame */
-    int64_t deadline = now_ns() + opt.period_ns;
-    const wc_loop_clock_t clock = opt.frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
-    while (!stop_requested && (opt.max_steps == 0 || loop.counters.steps < opt.max_steps)) {
-        wc_can_frame_t frame;
-        const int64_t wait_ns = opt.frame_clock ? 100000000LL : deadline - now_ns();
-        const int got = (wait_ns > 0) ? wc_socketcan_receive(&port, &frame, wait_ns / 1000) : 0;
-        if (got < 0) {
-            fprintf(stderr, "wc_tcu: %s\n", port.error);
-            status = 1;
-            break;
-        }
-        const int64_t t = now_ns();
-        if (got == 1) {
-            last_rx = t;
-        } else if (opt.idle_exit_s > 0 && last_rx >= 0 && (double)(t - last_rx) > opt.idle_exit_s * 1e9) {
-            break;
-        }
-        bool tick = false;
-        if (!opt.frame_clock && t >= deadline) {
-            tick = true;
-            deadline += opt.period_ns;
-            if (t >= deadline) {  /* late by a whole period or more: skip, count */
-                const int64_t missed = (t - deadline) / opt.period_ns + 1;
-                deadline += missed * opt.period_ns;
-                wc_loop_deadline_missed(&loop, (uint32_t)missed);
-            }
-        }
-        const int64_t t0 = now_ns();
-        wc_can_frame_t out[WC_LOOP_TX_FRAMES];
-        const uint32_t n = wc_loop_iterate(&loop, clock, (got == 1) ? &frame : NULL, tick, out);
-        if (n == 0u) { continue; }
-        for (uint32_t i = 0; i < n; ++i) {
-            if (wc_socketcan_send(&port, &out[i]) != 0) {
-                if (tx_errors == 0) { fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port.error); }
-                tx_errors++;
-            }
-        }
-        record(&times, now_ns() - t0);
-    }
+    port_stats_t ps = { 0u, 0u };
+    const int status = run(&opt, &loop, &port, &times, &ps);
     wc_socketcan_close(&port);
-    report(stderr, 0, &loop.counters, tx_errors, port.rx_dropped, &times);
-    if (opt.stats_json != NULL) {
-        FILE *f = fopen(opt.stats_json, "w");
-        if (f == NULL) {
-            fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
-            return 1;
-        }
-        report(f, 1, &loop.counters, tx_errors, port.rx_dropped, &times);
-        if (fclose(f) != 0) {
-            fprintf(stderr, "wc_tcu: cannot write %s: %s\n", opt.stats_json, strerror(errno));
-            return 1;
-        }
+    report(stderr, 0, &loop.counters, ps.tx_errors, port.rx_dropped, &times);
+    if ((opt.stats_json != NULL) && (write_stats_json(opt.stats_json, &loop.counters, &ps, port.rx_dropped, &times) != 0)) {
+        return 1;
     }
     return status;
 }

@@ -62,6 +62,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -70,7 +71,7 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.special import erf, erfc
 
-from . import calibration, canlog, model
+from . import atomic, calibration, canlog, model
 from .calibration import Calibration
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -563,7 +564,7 @@ def write_csv(path: Path, result: Result) -> None:
     fmt = ",".join(CSV_FORMATS)
     lines = [",".join(CSV_COLUMNS)]
     lines += [fmt % tuple(row) for row in np.column_stack(cols).tolist()]
-    path.write_text("\n".join(lines) + "\n")
+    atomic.write_text(path, "\n".join(lines) + "\n")
 
 
 def write_log(path: Path, result: Result) -> int:
@@ -576,7 +577,8 @@ def write_log(path: Path, result: Result) -> int:
                             m["torque_request_Nm"], mode=result.mode,
                             bench={"load_cell_N": m["force_N"], "torque_Nm": m["torque_Nm"],
                                    "thermistor_degC": m["theta_clutch_degC"]})
-    canlog.write_log(path, msgs)
+    with atomic.atomic_path(path) as tmp:
+        canlog.write_log(tmp, msgs)
     return len(msgs)
 
 
@@ -586,7 +588,7 @@ def write_index(path: Path, cal: Calibration, results: list[Result]) -> None:
         e = r.experiment
         lines.append(f"{e.id},{e.force_N:.1f},{e.force_N / cal.friction_area * 1e-3:.1f},{e.slip_rpm:.0f},"
                      f"{e.loading_s:.0f},{e.theta0_degC:.0f},{e.name}.csv")
-    path.write_text("\n".join(lines) + "\n")
+    atomic.write_text(path, "\n".join(lines) + "\n")
 
 
 def write_viscosity(path: Path, cal: Calibration, seed: int, noise: float = 0.01) -> None:
@@ -594,7 +596,7 @@ def write_viscosity(path: Path, cal: Calibration, seed: int, noise: float = 0.01
     rng = np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(b"viscosity")]))
     theta = np.arange(10.0, 121.0, 10.0)
     mu = model.viscosity_Pa_s(cal, theta) * (1.0 + noise * rng.standard_normal(theta.size))
-    path.write_text("theta_degC,viscosity_Pa_s\n" + "".join(f"{t:.0f},{m:.6e}\n" for t, m in zip(theta, mu)))
+    atomic.write_text(path, "theta_degC,viscosity_Pa_s\n" + "".join(f"{t:.0f},{m:.6e}\n" for t, m in zip(theta, mu)))
 
 
 def run(kind: str, out_dir, true_path=DEFAULT_TRUE, seed=DEFAULT_SEED, slips_rpm=None, logs: bool | None = None,
@@ -628,21 +630,22 @@ def run(kind: str, out_dir, true_path=DEFAULT_TRUE, seed=DEFAULT_SEED, slips_rpm
     out = _prepare_dir(out_dir)
     results = simulate(true_cal, experiments, seed, config, every)
     files = []
-    for r in results:
-        path = out / f"{r.experiment.name}.csv"
-        write_csv(path, r)
-        files.append(path)
-        if logs:
-            path = out / f"{r.experiment.name}.log"
-            write_log(path, r)
+    with atomic.Staged():   # all files or none (a full disk leaves no truncated CSV)
+        for r in results:
+            path = out / f"{r.experiment.name}.csv"
+            write_csv(path, r)
             files.append(path)
-    if kind == "table2":
-        path = out / "index.csv"
-        write_index(path, true_cal, results)
-        files.append(path)
-        path = out / "viscosity.csv"
-        write_viscosity(path, true_cal, seed)
-        files.append(path)
+            if logs:
+                path = out / f"{r.experiment.name}.log"
+                write_log(path, r)
+                files.append(path)
+        if kind == "table2":
+            path = out / "index.csv"
+            write_index(path, true_cal, results)
+            files.append(path)
+            path = out / "viscosity.csv"
+            write_viscosity(path, true_cal, seed)
+            files.append(path)
     return {"files": files, "results": results}
 
 
@@ -666,12 +669,30 @@ def engagement_figures(result: Result, contact_force_N: float = 50.0, locked_rpm
 
 # --------------------------------------------------------------------------- log conversion
 
+# Lines of a Vector ASC log that are not events: the header, comments, the trigger block's bounds.
+_ASC_HEADER = re.compile(r"(date\s|base\s|(no\s+)?internal\s+events\s+logged|begin\s+triggerblock|end\s+triggerblock"
+                         r"|//)", re.IGNORECASE)
+# what python-can's ASCReader parses as a frame (anything else it skips without a word)
+_ASC_PARSED = re.compile(r"\d+\.\d+\s+(\d+\s+(\w+\s+(Tx|Rx)|ErrorFrame)|CANFD)", re.ASCII | re.IGNORECASE)
+# events other than frames, skipped and counted: a channel's keyword event ("1 Statistic: ..."), another bus's
+# or the logger's event in capitals ("CAN 1 Status:...", "SV: ...", "J1939TP ...", "LIN ..."), markers
+_ASC_OTHER_EVENT = re.compile(r"\d+\.\d+\s+(\d+\s+[A-Za-z]\w*:|[A-Z][A-Z0-9]+:?(\s|$)|[Ll]og trigger event"
+                              r"|[Pp]retrigger)", re.ASCII)
+_ASC_START = re.compile(r"\d+\.\d+\s+start of measurement", re.IGNORECASE)
+
+
 class _CountingLines:
-    """A text file iterated line by line, remembering the line number (for errors)."""
+    """A text file iterated line by line for python-can's ASCReader, remembering the line number and
+    checking each line: python-can skips a line it does not understand without a word, so the first line
+    that is not a header line, a comment, a frame (parsed by python-can: a broken one is its ValueError)
+    or a known kind of other event (_ASC_OTHER_EVENT, counted in .events) is kept in .bad as
+    (line, reason), for convert_log to raise once it knows whether the file held any frame at all."""
 
     def __init__(self, f):
         self.f = f
         self.line = 0
+        self.events = 0
+        self.bad = None
 
     def __iter__(self):
         return self
@@ -679,6 +700,16 @@ class _CountingLines:
     def __next__(self):
         line = next(self.f)
         self.line += 1
+        text = line.strip()
+        if not text or _ASC_HEADER.match(text) or _ASC_PARSED.match(text) or _ASC_START.match(text):
+            return line
+        if _ASC_OTHER_EVENT.match(text):
+            self.events += 1
+            return line
+        if self.bad is None:
+            binary = any(ch < " " and ch != "\t" for ch in text) or "\x7f" in text
+            self.bad = (self.line, "binary data" if binary else
+                        f"not a Vector ASC line (header, comment, frame or event): {text[:60]!r}")
         return line
 
     def close(self):
@@ -686,12 +717,16 @@ class _CountingLines:
 
 
 def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
-    """Vector ASC or BLF (python-can readers) -> candump -L (canlog.write_log).
+    """Vector ASC or BLF (python-can readers) -> candump -L (canlog.write_log), written atomically.
 
-    Classic CAN data frames are written with the file's timestamps. Error
-    frames, remote frames and CAN FD frames (the DBC is classic CAN) are
-    skipped and counted. A malformed file raises LogError naming the file
-    (and for ASC the line); nothing is written then.
+    Classic CAN data frames are written with the file's timestamps, in the file's order. Error
+    frames, remote frames and CAN FD frames (the DBC is classic CAN) are skipped and counted, and so
+    are an ASC file's other events (statistics, chip status, ...). A malformed file raises LogError
+    naming the file (and for ASC the line: a broken frame, or a line that is neither header,
+    comment, frame nor a known kind of event, see _CountingLines); nothing is written then. A frame
+    earlier than the one before it is copied as is and listed in 'out_of_order' as (where,
+    timestamp, previous timestamp), where being 'line N' (ASC) or 'frame N' (BLF), for the caller
+    to warn about.
     """
     import can
     import struct
@@ -705,9 +740,10 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
         raise LogError(f"{in_path}: unsupported log format {in_path.suffix or '(no suffix)'!r}:"
                        " expected a Vector .asc or .blf file")
     if not in_path.is_file():
-        raise LogError(f"{in_path}: no such log file")
+        raise LogError(f"{in_path}: {'not a file' if in_path.exists() else 'no such log file'}")
     messages: list = []
-    skipped = {"error": 0, "remote": 0, "fd": 0}
+    skipped = {"error": 0, "remote": 0, "fd": 0, "event": 0}
+    out_of_order: list = []
     lines = None
     try:
         if suffix == ".asc":
@@ -717,8 +753,8 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
         else:
             reader = can.BLFReader(str(in_path))
         with reader:
-            for msg in reader:
-                where = f"line {lines.line}" if lines is not None else f"frame {len(messages) + sum(skipped.values()) + 1}"
+            for k, msg in enumerate(reader, start=1):
+                where = f"line {lines.line}" if lines is not None else f"frame {k}"
                 if msg.is_error_frame:
                     skipped["error"] += 1
                 elif msg.is_remote_frame:
@@ -728,14 +764,34 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
                 elif len(msg.data) != msg.dlc:
                     raise LogError(f"{in_path}: {where}: {len(msg.data)} data bytes, DLC says {msg.dlc}")
                 else:
-                    messages.append((float(msg.timestamp), msg))
+                    stamp = float(msg.timestamp)
+                    if not math.isfinite(stamp):
+                        raise LogError(f"{in_path}: {where}: timestamp {stamp} is not finite")
+                    if messages and stamp < messages[-1][0]:
+                        out_of_order.append((where, stamp, messages[-1][0]))
+                    messages.append((stamp, msg))
     except LogError:
+        if lines is not None and lines.bad:   # an earlier line python-can skipped is the first problem
+            raise LogError(f"{in_path}: line {lines.bad[0]}: {lines.bad[1]}") from None
         raise
+    except OSError as e:
+        raise LogError(f"{in_path}: cannot read: {e.strerror or e}") from None
     except (ValueError, IndexError, KeyError, struct.error, _zlib.error, EOFError, can.CanError,
             can.io.blf.BLFParseError) as e:
+        if lines is not None and lines.bad:
+            raise LogError(f"{in_path}: line {lines.bad[0]}: {lines.bad[1]}") from None
         where = f": line {lines.line}" if lines is not None else ""
         raise LogError(f"{in_path}{where}: not a valid Vector {suffix[1:].upper()} log ({type(e).__name__}: {e})") from None
+    bad = lines.bad if lines is not None else None
     if not messages:
-        raise LogError(f"{in_path}: no CAN data frames found (not a Vector {suffix[1:].upper()} log?)")
-    canlog.write_log(out_path, messages, channel=channel)
-    return {"frames": len(messages), "skipped": skipped, "span_s": messages[-1][0] - messages[0][0]}
+        raise LogError(f"{in_path}: no CAN data frames found (not a Vector {suffix[1:].upper()} log?"
+                       + (f" line {bad[0]}: {bad[1]}" if bad else "") + ")")
+    if bad:
+        raise LogError(f"{in_path}: line {bad[0]}: {bad[1]}")
+    if lines is not None:
+        skipped["event"] = lines.events
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic.atomic_path(out_path) as tmp:
+        canlog.write_log(tmp, messages, channel=channel)
+    return {"frames": len(messages), "skipped": skipped, "span_s": messages[-1][0] - messages[0][0],
+            "out_of_order": out_of_order}

@@ -103,17 +103,25 @@ def read_log(path: Path) -> list[can.Message]:
     """Read a candump -L log; a malformed line is an error naming the line."""
     path = Path(path)
     if not path.is_file():
-        raise LogError(f"{path}: no such log file")
+        raise LogError(f"{path}: {'not a file' if path.exists() else 'no such log file'}")
     messages = []
-    with open(path) as f:
-        for line_no, line in enumerate(f, start=1):
-            if not line.strip():
-                continue
-            try:
-                msg = next(iter(can.CanutilsLogReader([line])))
-            except (StopIteration, ValueError, IndexError) as e:
-                raise LogError(f"{path}: line {line_no}: not a candump -L line: {line.strip()!r} ({e})") from None
-            messages.append(msg)
+    try:
+        with open(path, encoding="utf-8") as f:
+            for line_no, line in enumerate(f, start=1):
+                if not line.strip():
+                    continue
+                try:
+                    msg = next(iter(can.CanutilsLogReader([line])))
+                except (StopIteration, ValueError, IndexError) as e:
+                    raise LogError(f"{path}: line {line_no}: not a candump -L line: {line.strip()[:80]!r} ({e})") \
+                        from None
+                if not np.isfinite(msg.timestamp):
+                    raise LogError(f"{path}: line {line_no}: timestamp {msg.timestamp} is not finite")
+                messages.append(msg)
+    except UnicodeDecodeError:
+        raise LogError(f"{path}: not UTF-8 text: not a candump -L log") from None
+    except OSError as e:
+        raise LogError(f"{path}: cannot read: {e.strerror}") from None
     return messages
 
 

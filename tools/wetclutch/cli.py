@@ -6,7 +6,9 @@ import os
 import sys
 from pathlib import Path
 
-from . import calibration, lut, reference, vectors
+import numpy as np
+
+from . import atomic, calibration, lut, model, reference, vectors
 from .csvio import CsvError, read_columns, write_columns
 from .errors import LogError
 
@@ -32,14 +34,32 @@ def _cmd_lut(args) -> int:
 def _cmd_reference(args) -> int:
     cal = calibration.load(args.calibration)
     source = args.input or "<stdin>"
-    stream = open(args.input, newline="") if args.input else sys.stdin
+    stream = open(args.input, newline="", encoding="utf-8") if args.input else sys.stdin
+    lines: list[int] = []
     with stream:
-        cols = read_columns(stream, reference.INPUTS[args.mode], source)
+        cols = read_columns(stream, reference.INPUTS[args.mode], source, finite=not args.keep_rejected, lines=lines)
     try:
-        out = reference.MODES[args.mode](cal, cols)
+        out = reference.MODES[args.mode](cal, cols, lines)
     except CsvError as e:
         raise CsvError(f"{source}: {e}") from None
-    write_columns(sys.stdout, out)
+    rejected = np.flatnonzero(out["status"] & model.STATUS_INPUT_INVALID)
+    if rejected.size and not args.keep_rejected:
+        k = int(rejected[0])
+        status = int(out["status"][k])
+        more = f" ({rejected.size} rows rejected)" if rejected.size > 1 else ""
+        raise CsvError(f"{source}: line {lines[k]}: input rejected by the firmware's input rules (status 0x{status:x}):"
+                       f" {reference.rejection_text(status)}{more}; --keep-rejected writes such rows with their status")
+    names = reference.OUTPUTS[args.mode] + (("status",) if args.keep_rejected and args.mode != "inverse" else ())
+    out = {n: out[n] for n in names}
+    if args.output:
+        with atomic.open_atomic(args.output, newline="") as f:
+            write_columns(f, out)
+    else:
+        write_columns(sys.stdout, out)
+    if rejected.size:
+        print(f"wetclutch reference: {source}: {rejected.size} row(s) rejected by the firmware's input rules, first"
+              f" at line {lines[int(rejected[0])]}: written with their status bits and the firmware's safe outputs",
+              file=sys.stderr)
     return 0
 
 
@@ -69,7 +89,8 @@ def _cmd_replay(args) -> int:
                            calibration=lut.c_identifier(Path(args.calibration).stem))
     missed = []
     for log, run_dir in jobs:
-        print(f"wetclutch replay: analysing {log.name} (reference check of every step)", file=sys.stderr, flush=True)
+        print(f"wetclutch replay: analysing {log.name}"
+              + ("" if args.no_reference_check else " (reference check of every step)"), file=sys.stderr, flush=True)
         m = report.analyse(cal, log, run_dir, reference_check=not args.no_reference_check)
         print((run_dir / "summary.md").read_text())
         print(f"report: {run_dir}/summary.md, metrics.json, {', '.join(Path(p).name for p in m['plots'])}")
@@ -123,12 +144,23 @@ def _cmd_bench(args) -> int:
     return 0
 
 
+_SKIPPED = {"error": "error frame(s)", "remote": "remote frame(s)", "fd": "CAN FD frame(s)",
+            "event": "non-CAN event line(s)"}
+
+
 def _cmd_convert(args) -> int:
     from . import bench
     stats = bench.convert_log(args.input, args.output, channel=args.channel)
-    skipped = ", ".join(f"{v} {k}" for k, v in stats["skipped"].items() if v)
+    for where, stamp, previous in stats["out_of_order"][:5]:
+        print(f"wetclutch convert: warning: {args.input}: {where}: timestamp {stamp:.6f} s is earlier than the"
+              f" frame before it ({previous:.6f} s): out of order, copied as is", file=sys.stderr)
+    if len(stats["out_of_order"]) > 5:
+        print(f"wetclutch convert: warning: {args.input}: {len(stats['out_of_order']) - 5} more out-of-order frames",
+              file=sys.stderr)
+    skipped = ", ".join(f"{v} {_SKIPPED[k]}" for k, v in stats["skipped"].items() if v)
     print(f"wrote {args.output}: {stats['frames']} frames over {stats['span_s']:.3f} s"
-          + (f" (skipped: {skipped} frame(s))" if skipped else ""))
+          + (f" (skipped: {skipped})" if skipped else "")
+          + (f"; {len(stats['out_of_order'])} out of order" if stats["out_of_order"] else ""))
     return 0
 
 
@@ -147,6 +179,11 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("mode", choices=sorted(reference.MODES))
     q.add_argument("--calibration", "-c", default=DEFAULT_CAL)
     q.add_argument("--input", "-i", help="input CSV (default: stdin)")
+    q.add_argument("--output", "-o", help="output CSV, written atomically (default: stdout)")
+    q.add_argument("--keep-rejected", action="store_true",
+                   help="write rows the firmware rejects (out of range, NaN, inf) with their status bits and the"
+                        " firmware's safe outputs, and a status column in every mode, instead of failing on the"
+                        " first one as wc_eval does")
     q.set_defaults(func=_cmd_reference)
 
     q = sub.add_parser("vectors", help="write golden vectors for the C tests")
@@ -198,15 +235,32 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def os_error_text(e: OSError) -> str:
+    """'path: reason' (atomic.py names the final path of an output), or the reason alone where the OS
+    named no file."""
+    reason = e.strerror or str(e)
+    if e.filename is None:
+        return reason
+    if e.filename2 is not None:
+        return f"{e.filename} -> {e.filename2}: {reason}"
+    return f"{e.filename}: {reason}"
+
+
 def main(argv=None) -> int:
+    """Exit 0 success, 1 a target missed (lut, identify, replay), 2 a usage or input error or an I/O
+    failure: one line on stderr naming the file, no traceback. Only the expected errors are caught here
+    (the I/O layer turns undecodable or malformed input into them); anything else is a bug and shows
+    its traceback."""
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except (calibration.CalibrationError, CsvError, lut.TableError, LogError, RuntimeError) as e:
+        if isinstance(e, (NotImplementedError, RecursionError)):
+            raise                # RuntimeError's subclasses that are bugs, not input errors
         print(f"wetclutch {args.command}: {e}", file=sys.stderr)
         return 2
     except OSError as e:
-        print(f"wetclutch {args.command}: {e.filename}: {e.strerror}", file=sys.stderr)
+        print(f"wetclutch {args.command}: {os_error_text(e)}", file=sys.stderr)
         return 2
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from pathlib import Path
 from typing import IO, Iterable, Mapping, Sequence
 
@@ -23,14 +24,34 @@ class CsvError(Exception):
     pass
 
 
+def _not_text(source, e: UnicodeDecodeError) -> CsvError:
+    return CsvError(f"{source}: not UTF-8 text ({e.reason}): not a CSV file")
+
+
+def _rows(reader: Iterable[list[str]], source: str, first_line: int) -> Iterable[tuple[int, list[str]]]:
+    """(line number, row) of the rows; the number is the csv.reader's own count where it has one.
+    Undecodable bytes and CSV syntax errors become CsvError naming the source (and the line)."""
+    line_no = first_line - 1
+    try:
+        for row in reader:
+            line_no = reader.line_num if hasattr(reader, "line_num") else line_no + 1
+            yield line_no, row
+    except UnicodeDecodeError as e:
+        raise _not_text(source, e) from None
+    except csv.Error as e:
+        raise CsvError(f"{source}: line {line_no + 1}: not valid CSV ({e})") from None
+
+
 def _parse_rows(rows: Iterable[list[str]], header: list[str], columns: Sequence[str], source: str,
-                missing_as_nan: bool) -> np.ndarray:
+                missing_as_nan: bool, finite: bool = True, lines: list[int] | None = None) -> np.ndarray:
     """Data rows (line 2 on) to an array of the columns; blank rows are skipped.
 
-    missing_as_nan False: every cell must be a finite number. True: an empty or nan/na/null cell is NaN."""
+    missing_as_nan False: every cell must be a number, and finite unless finite is False (then nan/inf
+    cells are NaN/infinite values). True: an empty or nan/na/null cell is NaN. lines, if given, receives the
+    line number of each data row returned."""
     index = [header.index(c) for c in columns]
     values_by_row = []
-    for line_no, row in enumerate(rows, start=2):
+    for line_no, row in _rows(rows, source, 2):
         if not row or all(not cell.strip() for cell in row):
             continue
         if len(row) != len(header):
@@ -45,24 +66,32 @@ def _parse_rows(rows: Iterable[list[str]], header: list[str], columns: Sequence[
                 v = float(cell)
             except ValueError:
                 raise CsvError(f"{source}: line {line_no}: column {c}: {row[i]!r} is not a number") from None
-            if not missing_as_nan and not math.isfinite(v):
+            if not missing_as_nan and finite and not math.isfinite(v):
                 raise CsvError(f"{source}: line {line_no}: column {c}: {row[i]!r} is not finite")
             values.append(v)
         values_by_row.append(values)
+        if lines is not None:
+            lines.append(line_no)
     return np.array(values_by_row, dtype=float).reshape(-1, len(columns))
 
 
-def read_columns(stream: IO[str], columns: Sequence[str], source: str = "<stdin>") -> dict[str, np.ndarray]:
-    """The columns of a CSV stream; every cell must be a finite number."""
+def read_columns(stream: IO[str], columns: Sequence[str], source: str = "<stdin>", finite: bool = True,
+                 lines: list[int] | None = None) -> dict[str, np.ndarray]:
+    """The columns of a CSV stream; every cell must be a number, a finite one unless finite is False.
+    lines, if given, receives the line number of each data row (blank lines are skipped)."""
     reader = csv.reader(stream)
     try:
         header = [h.strip() for h in next(reader)]
     except StopIteration:
         raise CsvError(f"{source}: empty input, expected a header: {','.join(columns)}") from None
+    except UnicodeDecodeError as e:
+        raise _not_text(source, e) from None
+    except csv.Error as e:
+        raise CsvError(f"{source}: line 1: not valid CSV ({e})") from None
     missing = [c for c in columns if c not in header]
     if missing:
         raise CsvError(f"{source}: line 1: missing column(s) {', '.join(missing)}; expected {','.join(columns)}")
-    data = _parse_rows(reader, header, columns, source, missing_as_nan=False)
+    data = _parse_rows(reader, header, columns, source, missing_as_nan=False, finite=finite, lines=lines)
     return {c: data[:, k] for k, c in enumerate(columns)}
 
 
@@ -120,9 +149,11 @@ def read_table(path: Path, required: Sequence[str], optional: Sequence[str] = ()
     check_header(header, required, str(path), units or {})
     columns = list(required) + [c for c in optional if c in header]
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, usecols=[header.index(c) for c in columns],
-                          dtype=float, ndmin=2, encoding="utf-8")
-    except ValueError:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")   # "input contained no data": reported below
+            data = np.loadtxt(path, delimiter=",", skiprows=1, usecols=[header.index(c) for c in columns],
+                              dtype=float, ndmin=2, encoding="utf-8")
+    except ValueError:   # also UnicodeDecodeError: _parse_file names the file
         data = _parse_file(path, header, columns)
     if data.shape[0] == 0:
         raise CsvError(f"{path}: no data rows")
@@ -131,9 +162,16 @@ def read_table(path: Path, required: Sequence[str], optional: Sequence[str] = ()
 
 def read_records(path: Path) -> list[tuple[int, dict]]:
     """The rows of a CSV file with text cells (an index), as (line number, {column: cell}); blank rows skipped."""
-    with open(path, newline="", encoding="utf-8") as f:
-        return [(line_no, row) for line_no, row in enumerate(csv.DictReader(f), start=2)
-                if row and not all(not (v or "").strip() for v in row.values())]
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            return [(line_no, row) for line_no, row in enumerate(csv.DictReader(f), start=2)
+                    if row and not all(not (v or "").strip() for v in row.values())]
+    except OSError as e:
+        raise CsvError(f"{path}: cannot read: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise _not_text(path, e) from None
+    except csv.Error as e:
+        raise CsvError(f"{path}: not valid CSV ({e})") from None
 
 
 def write_columns(stream: IO[str], columns: dict[str, np.ndarray], fmt: str = "{:.9g}") -> None:

@@ -10,14 +10,13 @@ would need about 2000 nodes (24 KiB with the same three arrays).
 """
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from . import model
+from .atomic import Staged
 from .calibration import PARAMETERS, Calibration
 
 FLOAT_BYTES = 4
@@ -167,18 +166,8 @@ def generate(cal: Calibration, out_dir: Path, name: str, command: str) -> dict:
         f"wc_{ident}_calibration.h": calibration_header(cal, ident, command),
     }
     out_dir.mkdir(parents=True, exist_ok=True)
-    staged = []
-    try:
+    with Staged() as out:
         for fname, text in files.items():
-            fd, tmp = tempfile.mkstemp(prefix=f".{fname}.", dir=out_dir)
-            with os.fdopen(fd, "w", newline="\n") as f:
-                f.write(text)
-            staged.append((tmp, out_dir / fname))
-        for tmp, final in staged:
-            os.replace(tmp, final)
-    finally:
-        for tmp, _ in staged:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+            out.write_text(out_dir / fname, text)
     return {"nodes": table.pressure_Pa.size, "bytes": table.size_bytes, "max_rel_error": error,
             "files": [str(out_dir / f) for f in files]}

@@ -17,10 +17,28 @@ from .calibration import Calibration
 
 RAD_S_PER_RPM = 2.0 * math.pi / 60.0
 
-# Status bits shared with the firmware (include/wc_status.h).
+# Status bits shared with the firmware (include/wetclutch/wc_status.h).
 STATUS_BELOW_DRAG = 1 << 0        # request below the drag at zero force: force 0
 STATUS_SATURATED = 1 << 1         # request above the capacity at maximum current
 STATUS_CURRENT_CLAMPED = 1 << 2   # current clamped to the solenoid range
+STATUS_SLIP_INVALID = 1 << 3      # slip speed NaN, infinite or out of range
+STATUS_THETA_INVALID = 1 << 4     # a temperature NaN, infinite or out of range
+STATUS_FORCE_INVALID = 1 << 5     # contact force NaN, infinite, negative or too large
+STATUS_TORQUE_INVALID = 1 << 6    # torque request NaN, infinite, negative or too large
+STATUS_POWER_INVALID = 1 << 7     # heat input NaN, infinite or negative
+STATUS_OVER_TEMPERATURE = 1 << 8  # estimate above THETA_OVER_DEGC (hysteresis THETA_OVER_HYSTERESIS_K)
+STATUS_NOT_INITIALISED = 1 << 9   # NULL or uninitialised instance (C only)
+# Thermal envelope (include/wetclutch/wc_config.h, DESIGN section 8).
+THETA_MIN_DEGC, THETA_MAX_DEGC = -40.0, 250.0
+THETA_OVER_DEGC, THETA_OVER_HYSTERESIS_K = 200.0, 10.0
+STATUS_INPUT_INVALID = (STATUS_SLIP_INVALID | STATUS_THETA_INVALID | STATUS_FORCE_INVALID | STATUS_TORQUE_INVALID
+                        | STATUS_POWER_INVALID)
+
+# The firmware's input ranges (include/wetclutch/wc_config.h; temperatures: THETA_MIN_DEGC, THETA_MAX_DEGC above),
+# checked in float32 as the firmware does (reference.py).
+SLIP_MAX_RAD_S = 1047.2           # WC_SLIP_MAX_rad_s: 10000 rpm
+FORCE_MAX_N = 1.0e5
+TORQUE_MAX_NM = 1.0e5
 
 
 def viscosity_Pa_s(cal: Calibration, theta_degC):
@@ -234,26 +252,31 @@ def thermal_steady_degC(cal: Calibration, power_W, theta_oil_degC, theta_housing
 
 
 def thermal_observer(cal: Calibration, slip_rpm, torque_Nm, theta_oil_degC, theta_housing_degC,
-                     theta_start_degC=None):
+                     theta_start_degC=None, held=None):
     """Eq. 1 over a series of control periods, exact for inputs held over each period.
 
     Row k's inputs are held from step k to k+1. Returns theta[k], the estimate
     before row k is applied; theta[0] is theta_start (default: first oil temperature).
-    Heat input P = |T dw| (W).
+    Heat input P = |T dw| (W). held: rows whose input is rejected (the firmware's
+    wc_thermal_step leaves its state untouched there); default none.
     """
     slip = np.asarray(slip_rpm, dtype=float)
-    power = np.abs(np.asarray(torque_Nm, dtype=float) * slip * RAD_S_PER_RPM)
-    steady = thermal_steady_degC(cal, power, theta_oil_degC, theta_housing_degC)
+    with np.errstate(over="ignore", invalid="ignore"):   # only in held rows, whose result is not used
+        power = np.abs(np.asarray(torque_Nm, dtype=float) * slip * RAD_S_PER_RPM)
+        steady = thermal_steady_degC(cal, power, theta_oil_degC, theta_housing_degC)
     a = thermal_decay(cal, cal.period)
     out = np.empty(slip.shape)
     theta = float(np.asarray(theta_oil_degC, dtype=float).flat[0]) if theta_start_degC is None else theta_start_degC
+    hold = np.zeros(slip.shape, bool) if held is None else np.asarray(held, bool)
     for k in range(slip.size):
         out[k] = theta
-        theta = steady[k] + (theta - steady[k]) * a
+        if not hold[k]:
+            theta = steady[k] + (theta - steady[k]) * a
     return out
 
 
-MODE_TORQUE, MODE_OPEN, MODE_LOCKED = 0, 1, 2
+# The clutch modes, numbered as the DBC's TorqueRequest.Mode and the C enum wc_clutch_mode_t.
+MODE_OPEN, MODE_TORQUE, MODE_LOCKED = 0, 1, 2
 
 
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
@@ -263,7 +286,9 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     Per step k: inverse at theta[k] (or the solenoid's minimum/maximum current
     for the open/locked modes) -> current; VFS lag (exact, tau) -> reached
     pressure -> contact force F = max(P A_p - F_s, 0) -> model torque;
-    observer advanced with |T dw|. Returns a dict of arrays; theta_degC[k] is
+    observer advanced with |T dw| and kept in [THETA_MIN_DEGC, THETA_MAX_DEGC],
+    STATUS_OVER_TEMPERATURE above THETA_OVER_DEGC until it falls THETA_OVER_HYSTERESIS_K
+    below (wc_clutch_step). Returns a dict of arrays; theta_degC[k] is
     the estimate used in step k (before its update). On a bench (rows where
     bench_force_N / bench_torque_Nm are given and not NaN) the torque model
     uses the measured force and the observer's heat input the measured torque.
@@ -281,6 +306,7 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     a_vfs = math.exp(-cal.period / cal.vfs_time_constant)
     theta = float(oil[0]) if theta_start_degC is None else float(theta_start_degC)
     pressure = cal.vfs_gain * cal.vfs_current_min
+    over = False
     names = ("current_mA", "pressure_command_Pa", "pressure_model_Pa", "force_command_N", "theta_degC",
              "torque_Nm", "mu_f", "hbar_m", "status")
     out = {k: np.empty(n) for k in names}
@@ -304,6 +330,13 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
         power = abs(heat_torque * slip[k] * RAD_S_PER_RPM)
         steady = float(thermal_steady_degC(cal, power, oil[k], housing[k]))
         theta = steady + (theta - steady) * a_th
+        theta = min(max(theta, THETA_MIN_DEGC), THETA_MAX_DEGC)      # thermal envelope
+        if theta > THETA_OVER_DEGC:
+            over = True
+        elif theta < THETA_OVER_DEGC - THETA_OVER_HYSTERESIS_K:
+            over = False
+        if over:
+            status |= STATUS_OVER_TEMPERATURE
         for key, value in (("current_mA", current), ("pressure_command_Pa", target), ("pressure_model_Pa", pressure),
                            ("force_command_N", force_cmd), ("torque_Nm", torque), ("mu_f", float(parts["mu_f"])),
                            ("hbar_m", float(parts["hbar_m"])), ("status", status)):

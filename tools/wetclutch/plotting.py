@@ -5,8 +5,9 @@ Agg backend: the reports are files, no display is needed.
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
+
+from .atomic import atomic_path
 
 DPI = 110
 
@@ -47,15 +48,13 @@ def style(ax, xlabel: str | None = None, ylabel: str | None = None, title: str |
 
 
 def save(fig, path: Path | str) -> str:
-    """Lay the figure out, write it (to a temporary file renamed into place, so a reader never sees half a
-    PNG) and close it. Returns the path as a string."""
+    """Lay the figure out, write it (atomic.atomic_path: a temporary renamed into place, so a reader never
+    sees half a PNG and a failure leaves nothing) and close it. Returns the path as a string."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp")
     try:
         fig.tight_layout()
-        fig.savefig(tmp, dpi=DPI, format=path.suffix.lstrip(".") or "png")
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=DPI, format=path.suffix.lstrip(".") or "png")
     finally:
         pyplot().close(fig)
-        tmp.unlink(missing_ok=True)
     return str(path)

@@ -24,10 +24,11 @@ from . import canlog, model
 from .calibration import Calibration
 
 ROOT = canlog.ROOT
-RX_NAMES = (canlog.SENSORS, canlog.REQUEST, canlog.BENCH)  # what wc_tcu's kernel filter lets in
-STATUS_BITS = ("StatusSensorTimeout", "StatusRequestTimeout", "StatusCrcError", "StatusCounterError",
-               "StatusImplausibleInput", "StatusSaturated", "StatusCurrentClamped", "StatusBelowDrag",
-               "StatusSafeStateActive", "StatusDeadlineMiss")
+RX_NAMES = (canlog.SENSORS, canlog.REQUEST, canlog.BENCH)  # what wc_tcu's kernel filter lets in (--bench)
+RX_CAPACITY = 32  # WC_LOOP_RX_CAPACITY: frames queued between two steps
+# VfsCommand's status word, bit n = the n-th 1-bit Status* signal (from the DBC, as the C codec).
+STATUS_BITS = tuple(sig.name for sig in canlog.database().get_message_by_name(canlog.COMMAND).signals
+                    if sig.name.startswith("Status") and sig.length == 1)
 BIT = {name: 1 << i for i, name in enumerate(STATUS_BITS)}
 
 
@@ -89,9 +90,10 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 # --------------------------------------------------------------------------- running on vcan
 
 def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
-                calibration: str = "table1") -> None:
+                calibration: str = "table1", bench: bool = True) -> None:
     """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
-    of jobs. Progress goes to stderr. Raises on failure."""
+    of jobs, wc_tcu with --bench unless bench is False. Progress goes to stderr.
+    Raises on failure."""
     tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
     if not tcu.is_file():
         raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
@@ -104,7 +106,7 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
         rw += ["--rwdir", str(job_out)]
         script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
                                   str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
-                                  "--tcu", str(tcu), "--calibration", calibration]))
+                                  "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else [])]))
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
@@ -117,63 +119,98 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
 
 @dataclass
 class _Input:
+    """One input of the loop: its E2E receiver (wc_e2e.h, AUTOSAR E2E Profile 1)
+    and its freshness, as src/can/wc_loop.c and src/can/wc_e2e.c."""
     timeout: int
+    max_delta: int = 2
+    sync_counter: int = 3
     age: int = 0
     seen: bool = False
     stale: bool = True
-    synced: bool = False
+    state: str = "init"          # init, nosync, syncing, valid
     previous: int = 0
+    in_sequence: int = 0
+    lost_last: bool = False
 
-    def counter_ok(self, counter: int) -> bool:
-        if not self.synced:
-            self.synced, self.previous = True, counter
-            return True
-        if counter == (self.previous + 1) % 16:
-            self.previous = counter
-            return True
-        if counter != self.previous:
-            self.previous = counter   # resynchronise on a jump
-        return False
+    def receive(self, counter: int) -> str:
+        """The receiver's status for this counter: ok, oksomelost, initial (used),
+        sync, repeated, wrongsequence (not used)."""
+        delta = (counter - self.previous) % 16
+        if self.state == "init":
+            self.previous, self.state = counter, "valid"
+            return "initial"
+        if self.state == "nosync":
+            return self._resync(counter, "sync")
+        if delta == 0:
+            return "repeated"
+        if self.state == "syncing":
+            if delta != 1:
+                return self._resync(counter, "wrongsequence")
+            self.previous, self.in_sequence = counter, self.in_sequence + 1
+            if self.in_sequence < self.sync_counter:
+                return "sync"
+            self.state, self.lost_last = "valid", False
+            return "ok"
+        if delta == 1:
+            self.previous, self.lost_last = counter, False
+            return "ok"
+        if delta <= self.max_delta and not self.lost_last:
+            self.previous, self.lost_last = counter, True
+            return "oksomelost"
+        return self._resync(counter, "wrongsequence")
+
+    def _resync(self, counter: int, status: str) -> str:
+        self.previous, self.state, self.in_sequence, self.lost_last = counter, "syncing", 0, False
+        return status
 
     def freshness(self) -> tuple[bool, bool]:
-        """(stale, timed_out_now), then one period older."""
+        """(stale, timed_out_now), then one period older; a timeout restarts the receiver."""
         stale = (not self.seen) or self.age >= self.timeout
         timed_out = stale and not self.stale and self.seen
         if timed_out:
-            self.seen, self.synced = False, False
+            self.seen, self.state = False, "nosync"
         self.stale = stale
         self.age += 1
         return stale, timed_out
 
 
 def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
-                   sensor_timeout: int = 10, request_timeout: int = 10) -> dict:
-    """What wc_tcu --clock frame computes for this sequence of received frames."""
+                   sensor_timeout: int = 10, request_timeout: int = 10, recovery_periods: int = 20,
+                   bench: bool = True) -> dict:
+    """What wc_tcu --clock frame [--bench] computes for this sequence of received frames
+    (WC_LOOP_CONFIG_DEFAULT: MaxDeltaCounter 2, SyncCounter 3, recovery 20 periods)."""
     db = canlog.database()
-    specs = {db.get_message_by_name(n).frame_id: db.get_message_by_name(n) for n in RX_NAMES}
+    names = RX_NAMES if bench else tuple(n for n in RX_NAMES if n != canlog.BENCH)  # wc_tcu's kernel filter
+    specs = {db.get_message_by_name(n).frame_id: db.get_message_by_name(n) for n in names}
     sensors_id = db.get_message_by_name(canlog.SENSORS).frame_id
     inputs = {n: _Input(request_timeout if n == canlog.REQUEST else sensor_timeout) for n in RX_NAMES}
     held = {"SlipSpeed": 0.0, "OilTemp": theta_start_degC, "HousingTemp": theta_start_degC,
             "TorqueRequest": 0.0, "Mode": float(canlog.MODE_OPEN), "LoadCellForce": 0.0, "MeasuredTorque": 0.0}
     e2e = set(canlog.E2E_FRAMES)
-    rejected = {k: 0 for k in ("crc", "counter", "short", "format", "implausible")}
+    rejected = {k: 0 for k in ("crc", "counter", "short", "format", "implausible", "overflow", "sync")}
     pending = 0
+    fresh_periods = 0
+    queue = []                            # the loop's receive ring, WC_LOOP_RX_CAPACITY frames
     rows = []
-    for msg in messages:
-        spec = specs.get(msg.arbitration_id)
-        if spec is None:
-            continue                      # the kernel filter of wc_tcu drops it
+
+    def process(spec, msg):
+        nonlocal pending
         if msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame:
             rejected["format"] += 1
+            pending |= BIT["StatusFrameLost"]
         elif len(msg.data) < 8:
             rejected["short"] += 1
+            pending |= BIT["StatusFrameLost"]
         elif spec.name in e2e and canlog.crc8_j1850(bytes([spec.frame_id & 0xFF]) + bytes(msg.data[1:8])) != msg.data[0]:
             rejected["crc"] += 1
             pending |= BIT["StatusCrcError"]
         else:
             state = inputs[spec.name]
             values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
-            if spec.name in e2e and not state.counter_ok(int(values["AliveCounter"])):
+            status = state.receive(int(values["AliveCounter"])) if spec.name in e2e else "ok"
+            if status == "sync":
+                rejected["sync"] += 1
+            elif status in ("repeated", "wrongsequence"):
                 rejected["counter"] += 1
                 pending |= BIT["StatusCounterError"]
             elif any(not (sig.minimum <= values[sig.name] <= sig.maximum)
@@ -184,17 +221,31 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
             else:
                 state.age, state.seen = 0, True
                 held.update({k: float(v) for k, v in values.items() if k in held})
+
+    for msg in messages:
+        spec = specs.get(msg.arbitration_id)
+        if spec is None:
+            continue                      # the kernel filter of wc_tcu drops it
+        if len(queue) < RX_CAPACITY:
+            queue.append((spec, msg))
+        else:                             # ring full: lost before its check (only silent sensors fill it)
+            rejected["overflow"] += 1
+            pending |= BIT["StatusFrameLost"]
         if msg.arbitration_id != sensors_id or msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame:
             continue
+        for queued in queue:
+            process(*queued)
+        queue.clear()
         bits, pending = pending, 0        # one step per ClutchSensors frame
         s_stale, _ = inputs[canlog.SENSORS].freshness()
         r_stale, _ = inputs[canlog.REQUEST].freshness()
-        b_stale, _ = inputs[canlog.BENCH].freshness()   # optional input: staleness is no fault
+        b_stale = inputs[canlog.BENCH].freshness()[0] if bench else True  # optional: staleness is no fault
         bits |= BIT["StatusSensorTimeout"] if s_stale else 0
         bits |= BIT["StatusRequestTimeout"] if r_stale else 0
-        safe = s_stale or r_stale
-        mode = {canlog.MODE_TORQUE_CONTROL: model.MODE_TORQUE, canlog.MODE_LOCKED: model.MODE_LOCKED}.get(
-            int(held["Mode"]), model.MODE_OPEN)
+        fresh_periods = 0 if (s_stale or r_stale) else fresh_periods + 1
+        safe = s_stale or r_stale or fresh_periods < recovery_periods   # debounce (wc_loop.h)
+        bits |= 0 if b_stale else BIT["StatusBenchInput"]
+        mode = int(held["Mode"])  # model.MODE_* are the DBC's values
         rows.append((held["SlipSpeed"], held["OilTemp"], held["HousingTemp"], held["TorqueRequest"],
                      model.MODE_OPEN if safe else mode, bits | (BIT["StatusSafeStateActive"] if safe else 0),
                      np.nan if b_stale else max(held["LoadCellForce"], 0.0),
@@ -210,6 +261,7 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
     bits |= np.where(status & model.STATUS_SATURATED, BIT["StatusSaturated"], 0)
     bits |= np.where(status & model.STATUS_CURRENT_CLAMPED, BIT["StatusCurrentClamped"], 0)
     bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
+    bits |= np.where(status & model.STATUS_OVER_TEMPERATURE, BIT["StatusOverTemperature"], 0)
     return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
             "bench_force_N": load, "bench_torque_Nm": measured_torque,
             "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
@@ -258,5 +310,5 @@ def compare(reference: dict, outputs: dict) -> dict:
 def load_stats(path: Path) -> dict:
     try:
         return json.loads(Path(path).read_text())
-    except (OSError, json.JSONDecodeError) as e:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise canlog.LogError(f"{path}: wc_tcu statistics unreadable: {e}") from None

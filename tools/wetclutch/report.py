@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import canlog, plotting, replay
+from . import atomic, canlog, plotting, replay
 from .calibration import Calibration
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15
@@ -248,7 +248,8 @@ def analyse(cal: Calibration, log: Path, run_dir: Path, reference_check: bool = 
     m["log"] = str(log)
     log_check = replay.check_log(log)
     m["log_problems"] = log_check.problems()
-    m["plots"] = plots(cal, s, m, run_dir)
-    (run_dir / "metrics.json").write_text(json.dumps(m, indent=2, default=float) + "\n")
-    (run_dir / "summary.md").write_text(summary(m, Path(log).name))
+    with atomic.Staged() as out:   # the plots, metrics.json and summary.md: all or none
+        m["plots"] = plots(cal, s, m, run_dir)
+        out.write_text(run_dir / "metrics.json", json.dumps(m, indent=2, default=float) + "\n")
+        out.write_text(run_dir / "summary.md", summary(m, Path(log).name))
     return m

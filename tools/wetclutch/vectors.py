@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import reference
+from . import atomic, reference
 from .calibration import Calibration
 from .lut import banner
 
@@ -74,7 +74,5 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     path = out_dir / "wc_golden_vectors.h"
-    tmp = path.with_suffix(".h.tmp")
-    tmp.write_text(text, newline="\n")
-    tmp.replace(path)
+    atomic.write_text(path, text)
     return [str(path)]

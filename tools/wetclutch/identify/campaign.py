@@ -121,6 +121,11 @@ def find_campaigns(data_dir: Path, notes: list[str] | None = None) -> list[Campa
     campaigns = []
     for folder in [data_dir] + sorted(p for p in data_dir.iterdir() if p.is_dir() and not p.name.startswith(".")):
         csvs = sorted(p for p in folder.glob("*.csv") if p.name != VISCOSITY_FILE)
+        for p in csvs:   # a CSV that cannot be read (binary, empty, a directory) is named, not skipped
+            try:
+                csvio.read_header(p)
+            except csvio.CsvError as e:
+                raise IdentifyError(str(e)) from None
         indexes = [p for p in csvs if _is_index(p)]
         listed = set()
         for p in indexes:
@@ -178,6 +183,9 @@ def _prepare(job: tuple) -> dict:
         k = np.arange(t.size)
         t = np.interp(k, k[finite_t], tf)
     needed = [cols[c] for c in MEASUREMENT_COLUMNS[1:]]
+    for c, x in zip(MEASUREMENT_COLUMNS[1:], needed):
+        if not np.isfinite(x).any():
+            raise IdentifyError(f"{path}: column {c}: no finite value (every cell empty, NaN or infinite)")
     valid = finite_t & np.all(np.isfinite(np.vstack(needed)), axis=0)
     out = {"id": exp_id, "file": str(path), "dt": dt, "rows": int(t.size), "t0": float(t[0]), "t1": float(t[-1])}
 

@@ -5,11 +5,11 @@ previous ones found (the calibration values and the thermistor lag).
 """
 from __future__ import annotations
 
-import os
 import time
 from pathlib import Path
 
 from .. import lut
+from ..atomic import Staged
 from ..calibration import Calibration, CalibrationError, load as load_calibration, render_calibration
 from .campaign import Campaign, find_campaigns, find_viscosity, prepare_campaign
 from .friction import friction_data, identify_asperity, identify_mu
@@ -122,7 +122,10 @@ def read_true(path: Path) -> dict[str, float]:
 
 def write_outputs(res: Result, base_path: Path, out_dir: Path, command: str, true_path: Path | None,
                   plots: bool = True) -> dict:
-    """calibration.toml (checked by calibration.load and a LUT build), report.md, figures.json, PNGs."""
+    """calibration.toml (checked by calibration.load and a LUT build), report.md, figures.json, PNGs.
+
+    All or nothing (atomic.Staged): on any failure (a rejected calibration, a full disk) none of the
+    files is written and an earlier run's files in out_dir are left as they were."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     changes = identified_values(res)
@@ -131,18 +134,20 @@ def write_outputs(res: Result, base_path: Path, out_dir: Path, command: str, tru
               f"# Base: {base_path}; identified values carry their source below.\n")
     text = render_calibration(base_path, res.base, changes, sources, header)
     cal_path = out_dir / "calibration.toml"
-    tmp = out_dir / ".calibration.toml.tmp"
-    tmp.write_text(text, encoding="utf-8")
-    try:
-        load_calibration(tmp)
-    except CalibrationError as e:
-        tmp.unlink()
-        raise IdentifyError(f"the identified calibration is rejected by calibration.load: {e}") from None
-    os.replace(tmp, cal_path)
-    check = load_calibration(cal_path)
-    table = lut.build_table(check)
-    lut_error = lut.max_relative_error(check, table)
     truth = read_true(true_path) if true_path else None
-    return write_report(res, out_dir, command, truth, str(true_path) if true_path else None,
-                        {"path": str(cal_path), "lut_max_rel_error": lut_error,
-                         "lut_nodes": int(table.pressure_Pa.size)}, plots)
+    with Staged() as out:
+        with out.path(cal_path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+            try:
+                check = load_calibration(tmp)
+            except CalibrationError as e:
+                raise IdentifyError("the identified calibration is rejected by calibration.load: "
+                                    + str(e).replace(str(tmp), str(cal_path))) from None
+            try:
+                table = lut.build_table(check)
+            except lut.TableError as e:
+                raise IdentifyError(f"the identified calibration makes no film table: {e}") from None
+        lut_error = lut.max_relative_error(check, table)
+        return write_report(res, out_dir, command, truth, str(true_path) if true_path else None,
+                            {"path": str(cal_path), "lut_max_rel_error": lut_error,
+                             "lut_nodes": int(table.pressure_Pa.size)}, plots)

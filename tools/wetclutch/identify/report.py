@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import model
+from ..atomic import Staged
 from .friction import identify_mu, mu_grid
 from .plots import plots as make_plots
 from .result import identified_values
@@ -168,17 +169,19 @@ def _json_default(o):
 
 def write_report(res: Result, out_dir: Path, command: str, truth: dict | None, true_path: str | None,
                  calinfo: dict, plots: bool = True) -> dict:
-    """exclusions.csv, the plots, figures.json and report.md in out_dir; returns the figures."""
+    """exclusions.csv, the plots, figures.json and report.md in out_dir, all or nothing (atomic.Staged; joins
+    the caller's block); returns the figures."""
     out_dir = Path(out_dir)
     fig = figures(res, command, truth, true_path, calinfo)
-    with open(out_dir / "exclusions.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=EXCLUSION_COLUMNS, lineterminator="\n")
-        w.writeheader()
-        for e in res.exclusions:
-            w.writerow(e.row())
-    fig["plots"] = make_plots(res, out_dir, truth) if plots else []
-    (out_dir / "figures.json").write_text(json.dumps(fig, indent=2, default=_json_default) + "\n")
-    (out_dir / "report.md").write_text(markdown(res, fig))
+    with Staged() as out:
+        with out.open(out_dir / "exclusions.csv", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=EXCLUSION_COLUMNS, lineterminator="\n")
+            w.writeheader()
+            for e in res.exclusions:
+                w.writerow(e.row())
+        fig["plots"] = make_plots(res, out_dir, truth) if plots else []
+        out.write_text(out_dir / "figures.json", json.dumps(fig, indent=2, default=_json_default) + "\n")
+        out.write_text(out_dir / "report.md", markdown(res, fig))
     return fig
 
 

@@ -200,7 +200,8 @@ def prepare_friction(exp_id, t, cols, valid, dt, effective_radius, s: Settings) 
     k = np.floor((t - t[0]) / s.bin_s + 1e-6).astype(np.int64)
     k = k[use]
     # bins of consecutive usable samples: average; a bin never spans excluded samples
-    breaks = np.concatenate([[True], (np.diff(k) != 0) | (np.diff(np.flatnonzero(use)) != 1)])
+    breaks = np.concatenate([[True], (np.diff(k) != 0) | (np.diff(np.flatnonzero(use)) != 1)]) if k.size else \
+        np.zeros(0, bool)   # no usable sample: no bin
     group = np.cumsum(breaks) - 1
     count = np.bincount(group).astype(float)
 
