@@ -31,6 +31,7 @@ done
 [ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
 for tool in candump canplayer; do command -v $tool >/dev/null || die "$tool not found (Debian package can-utils; bash scripts/setup.sh)"; done
 [ -n "$log_iface" ] || log_iface=$(awk 'NF>=3 {print $2; exit}' "$log")
+pin=""; command -v taskset >/dev/null && pin="taskset -c 0"
 mkdir -p "$out"
 
 one_run() { # clock name
@@ -42,7 +43,12 @@ one_run() { # clock name
   for _ in $(seq 100); do grep -q "clock $clock" "$out/$name.txt" 2>/dev/null && break; sleep 0.05; done
   grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill $dump_pid $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }
   sleep 0.2  # candump's socket is bound by now too
-  canplayer -I "$log" "$iface=$log_iface"
+  # One CPU for the sender: vcan queues each frame on the sending CPU's backlog,
+  # so a canplayer that migrates between CPUs can have two frames of the same
+  # millisecond (BenchMeasurement, ClutchSensors) delivered out of order, and
+  # the frame clock would step on a different bench value (seen in the
+  # emulated guest under load). Pinned, the delivery order is the log's.
+  $pin canplayer -I "$log" "$iface=$log_iface"
   wait $tcu_pid || rc=$?
   # candump may lag behind the bus (slow in an emulated guest): stop it only
   # once its capture has stopped growing, or it drops what it still queues.

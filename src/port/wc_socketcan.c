@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <linux/can.h>
+#include <linux/can/error.h>
 #include <linux/can/raw.h>
 #include <net/if.h>
 #include <poll.h>
@@ -25,10 +26,27 @@ int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *f
 {
     port->fd = -1;
     port->rx_dropped = 0;
+    port->bus_errors = 0;
+    port->bus_off = false;
     port->error[0] = '\0';
-    if (strlen(iface) >= IFNAMSIZ) {
+    if ((strlen(iface) >= IFNAMSIZ) || (strlen(iface) >= sizeof port->iface)) {
         return fail(port, "interface name too long", ENAMETOOLONG, "");
     }
+    if (count > WC_SOCKETCAN_MAX_FILTERS) {
+        return fail(port, "too many receive filters", EINVAL, "");
+    }
+    (void)snprintf(port->iface, sizeof port->iface, "%s", iface);
+    memcpy(port->filter_ids, filter_ids, count * sizeof filter_ids[0]);
+    port->filter_count = count;
+    return wc_socketcan_reopen(port);
+}
+
+int wc_socketcan_reopen(wc_socketcan_t *port)
+{
+    wc_socketcan_close(port);
+    const char *iface = port->iface;
+    const uint32_t *filter_ids = port->filter_ids;
+    const size_t count = port->filter_count;
     const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
     if (fd < 0) {
         const int err = errno;
@@ -48,10 +66,6 @@ int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *f
         (void)close(fd);
         return fail(port, iface, err, hint);
     }
-    if (count > WC_SOCKETCAN_MAX_FILTERS) {
-        (void)close(fd);
-        return fail(port, "too many receive filters", EINVAL, "");
-    }
     struct can_filter filters[WC_SOCKETCAN_MAX_FILTERS];
     for (size_t i = 0; i < count; ++i) {
         filters[i].can_id = filter_ids[i] & CAN_SFF_MASK;
@@ -61,6 +75,15 @@ int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *f
         const int err = errno;
         (void)close(fd);
         return fail(port, "setsockopt(CAN_RAW_FILTER)", err, "");
+    }
+    /* Error frames: every class the controller reports, so that bus-off and
+     * error passive are seen (they arrive with CAN_ERR_FLAG set). */
+    const can_err_mask_t err_mask = CAN_ERR_TX_TIMEOUT | CAN_ERR_LOSTARB | CAN_ERR_CRTL | CAN_ERR_PROT |
+                                    CAN_ERR_TRX | CAN_ERR_ACK | CAN_ERR_BUSOFF | CAN_ERR_BUSERROR | CAN_ERR_RESTARTED;
+    if (setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof err_mask) < 0) {
+        const int err = errno;
+        (void)close(fd);
+        return fail(port, "setsockopt(CAN_RAW_ERR_FILTER)", err, "");
     }
     /* Ask for the kernel's drop counter with every frame, so no loss goes unseen,
      * and a receive buffer large enough for bursts of a replayed log. */
@@ -93,23 +116,33 @@ int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t ti
     struct timespec timeout = { .tv_sec = (time_t)(timeout_us / 1000000), .tv_nsec = (long)(timeout_us % 1000000) * 1000L };
     const int ready = ppoll(&pfd, 1, (timeout_us < 0) ? NULL : &timeout, NULL);  /* ns resolution, unlike poll */
     if (ready < 0) {
-        if (errno == EINTR) { return 0; }
-        return fail(port, "poll", errno, "");
+        if (errno == EINTR) { return WC_SOCKETCAN_NONE; }
+        (void)fail(port, "poll", errno, "");
+        return WC_SOCKETCAN_FAILED;
     }
-    if (ready == 0) { return 0; }
+    if (ready == 0) { return WC_SOCKETCAN_NONE; }
     struct can_frame raw;
     char control[CMSG_SPACE(sizeof(uint32_t))];
     struct iovec iov = { .iov_base = &raw, .iov_len = sizeof raw };
     struct msghdr msg = { .msg_iov = &iov, .msg_iovlen = 1, .msg_control = control, .msg_controllen = sizeof control };
     const ssize_t n = recvmsg(port->fd, &msg, 0);
     if (n < 0) {
-        if ((errno == EINTR) || (errno == EAGAIN)) { return 0; }
-        return fail(port, "read", errno, "");
+        const int err = errno;
+        if ((err == EINTR) || (err == EAGAIN)) { return WC_SOCKETCAN_NONE; }
+        (void)fail(port, "read", err, ((err == ENETDOWN) || (err == ENODEV) || (err == ENXIO))
+                                          ? "interface down: the loop keeps its safe state and reopens" : "");
+        return ((err == ENETDOWN) || (err == ENODEV) || (err == ENXIO)) ? WC_SOCKETCAN_DOWN : WC_SOCKETCAN_FAILED;
     }
     for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c != NULL; c = CMSG_NXTHDR(&msg, c)) {
         if ((c->cmsg_level == SOL_SOCKET) && (c->cmsg_type == SO_RXQ_OVFL)) {
             memcpy(&port->rx_dropped, CMSG_DATA(c), sizeof port->rx_dropped);  /* cumulative */
         }
+    }
+    if ((size_t)n >= sizeof raw && (raw.can_id & CAN_ERR_FLAG) != 0u) {
+        port->bus_errors++;
+        if ((raw.can_id & CAN_ERR_BUSOFF) != 0u) { port->bus_off = true; }
+        if ((raw.can_id & CAN_ERR_RESTARTED) != 0u) { port->bus_off = false; }
+        return WC_SOCKETCAN_BUS_ERROR;
     }
     memset(frame, 0, sizeof *frame);
     if ((size_t)n < sizeof raw) {  /* never from a CAN_RAW socket, but never trust a length */
@@ -133,9 +166,10 @@ int wc_socketcan_send(wc_socketcan_t *port, const wc_can_frame_t *frame)
     raw.can_id = frame->id & CAN_SFF_MASK;
     raw.len = (frame->dlc <= 8u) ? frame->dlc : 8u;
     memcpy(raw.data, frame->data, raw.len);
-    const ssize_t n = write(port->fd, &raw, sizeof raw);
+    const ssize_t n = send(port->fd, &raw, sizeof raw, MSG_DONTWAIT);  /* never block the loop */
     if (n != (ssize_t)sizeof raw) {
-        return fail(port, "write", (n < 0) ? errno : EIO, (errno == ENOBUFS) ? "transmit queue full" : "");
+        const int err = (n < 0) ? errno : EIO;
+        return fail(port, "send", err, ((err == ENOBUFS) || (err == EAGAIN)) ? "transmit queue full" : "");
     }
     return 0;
 }

@@ -11,6 +11,8 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <getopt.h>
+#include <sched.h>
+#include <sys/mman.h>
 #include <stdbool.h>
 #include <signal.h>
 #include <stdint.h>
@@ -45,6 +47,7 @@ typedef struct {
     double theta_start_degC;
     unsigned sensor_timeout, request_timeout;
     int bench;                /* --bench: BenchMeasurement used (and passed by the kernel filter) */
+    int realtime;             /* --realtime: SCHED_FIFO + mlockall where permitted */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -98,6 +101,7 @@ static void usage(FILE *out)
             "      --request-timeout N   TorqueRequest timeout in periods (default 10)\n"
             "  -b, --bench               use BenchMeasurement (0x130: load cell, torque sensor) as the\n"
             "                            paper's validation does; off: the frame is filtered out\n"
+            "      --realtime            SCHED_FIFO priority 50 and mlockall, where permitted (reported)\n"
             "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
             "  -h, --help\n");
 }
@@ -123,7 +127,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"steps", required_argument, NULL, 'n'},       {"idle-exit", required_argument, NULL, 'I'},
         {"theta-start", required_argument, NULL, 't'}, {"stats-json", required_argument, NULL, 'j'},
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
-        {"bench", no_argument, NULL, 'b'},
+        {"bench", no_argument, NULL, 'b'},            {"realtime", no_argument, NULL, 3},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
@@ -144,6 +148,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
         case 'j': o->stats_json = optarg; break;
         case 'b': o->bench = 1; break;
+        case 3: o->realtime = 1; break;
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; break;
         case 'h':
@@ -194,6 +199,22 @@ static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx
     fprintf(out, "\n");
 }
 
+/* --realtime: SCHED_FIFO and locked memory where the system permits it; the
+ * outcome is reported, a refusal is not an error. */
+static void realtime(void)
+{
+    struct sched_param param;
+    memset(&param, 0, sizeof param);
+    param.sched_priority = 50;
+    const int fifo = sched_setscheduler(0, SCHED_FIFO, &param);
+    const int fifo_errno = errno;
+    const int locked = mlockall(MCL_CURRENT | MCL_FUTURE);
+    const int lock_errno = errno;
+    fprintf(stderr, "wc_tcu: realtime: SCHED_FIFO priority 50 %s%s, mlockall %s%s\n", (fifo == 0) ? "on" : "refused: ",
+            (fifo == 0) ? "" : strerror(fifo_errno), (locked == 0) ? "on" : "refused: ",
+            (locked == 0) ? "" : strerror(lock_errno));
+}
+
 static const wc_calibration_t *find_calibration(const char *name)
 {
     for (size_t i = 0; i < wc_tcu_calibration_count; ++i) {
@@ -208,6 +229,8 @@ static const wc_calibration_t *find_calibration(const char *name)
 typedef struct {
     uint64_t tx_errors;
     uint32_t rx_dropped_seen;  /* port->rx_dropped already reported to the loop */
+    uint32_t downs;            /* times the interface went down */
+    int64_t next_reopen_ns;    /* while down: when to try again */
 } port_stats_t;
 
 /* The main loop until a signal, --steps or --idle-exit: wait for a frame or
@@ -223,17 +246,35 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step
     while (!stop_requested && (opt->max_steps == 0 || loop->counters.steps < opt->max_steps)) {
         wc_can_frame_t frame;
         const int64_t wait_ns = opt->frame_clock ? 100000000LL : deadline - now_ns();
-        const int got = (wait_ns > 0) ? wc_socketcan_receive(port, &frame, wait_ns / 1000) : 0;
-        if (got < 0) {
+        int got = (wait_ns > 0) ? wc_socketcan_receive(port, &frame, wait_ns / 1000) : WC_SOCKETCAN_NONE;
+        if (got == WC_SOCKETCAN_FAILED) {
             fprintf(stderr, "wc_tcu: %s\n", port->error);
             return 1;
+        }
+        if (got == WC_SOCKETCAN_BUS_ERROR) {  /* error passive, bus-off, controller problem: flagged */
+            wc_loop_port_event(loop, WC_LOOP_PORT_BUS_ERROR, 1u);
+            got = WC_SOCKETCAN_NONE;
+        }
+        if ((got == WC_SOCKETCAN_DOWN) || ((port->fd < 0) && (now_ns() >= ps->next_reopen_ns))) {
+            /* The interface went down: never exit. The inputs time out (safe
+             * state), sends fail (counted); reopen every 100 ms until it is back. */
+            if (got == WC_SOCKETCAN_DOWN) {
+                fprintf(stderr, "wc_tcu: %s\n", port->error);
+                ps->downs++;
+                wc_loop_port_event(loop, WC_LOOP_PORT_BUS_ERROR, 1u);
+                wc_socketcan_close(port);
+            } else if (wc_socketcan_reopen(port) == 0) {
+                fprintf(stderr, "wc_tcu: %s reopened\n", opt->iface);
+            }
+            ps->next_reopen_ns = now_ns() + 100000000LL;
+            got = WC_SOCKETCAN_NONE;
         }
         if (port->rx_dropped != ps->rx_dropped_seen) {
             wc_loop_port_event(loop, WC_LOOP_PORT_RX_DROPPED, port->rx_dropped - ps->rx_dropped_seen);
             ps->rx_dropped_seen = port->rx_dropped;
         }
         const int64_t t = now_ns();
-        if (got == 1) {
+        if (got == WC_SOCKETCAN_FRAME) {
             last_rx = t;
         } else if (opt->idle_exit_s > 0 && last_rx >= 0 && (double)(t - last_rx) > opt->idle_exit_s * 1e9) {
             return 0;
@@ -250,7 +291,7 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step
         }
         const int64_t t0 = now_ns();
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
-        const uint32_t n = wc_loop_iterate(loop, clock, (got == 1) ? &frame : NULL, tick, out);
+        const uint32_t n = wc_loop_iterate(loop, clock, (got == WC_SOCKETCAN_FRAME) ? &frame : NULL, tick, out);
         if (n == 0u) { continue; }
         for (uint32_t i = 0; i < n; ++i) {
             if (wc_socketcan_send(port, &out[i]) != 0) {
@@ -299,7 +340,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
         return 2;
     }
-    if (opt.period_ns == 0) { opt.period_ns = (int64_t)((double)cal->control_period_s * 1e9 + 0.5); }
+    /* The model is discretised for the calibration's period (eq. 1 and the VFS
+     * lag, exact for that dt): another step period would be a wrong model. */
+    const int64_t cal_period_ns = (int64_t)((double)cal->control_period_s * 1e9 + 0.5);
+    if (opt.period_ns == 0) { opt.period_ns = cal_period_ns; }
+    if (llabs(opt.period_ns - cal_period_ns) > 1000) {
+        fprintf(stderr, "wc_tcu: --period-us %lld does not match the calibration's control period of %lld us"
+                        " (the model is discretised for it)\n", (long long)(opt.period_ns / 1000),
+                (long long)(cal_period_ns / 1000));
+        return 2;
+    }
+    if (opt.realtime) { realtime(); }
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -320,7 +371,7 @@ int main(int argc, char **argv)
             opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration,
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
-    port_stats_t ps = { 0u, 0u };
+    port_stats_t ps = { 0u, 0u, 0u, 0 };
     const int status = run(&opt, &loop, &port, &times, &ps);
     wc_socketcan_close(&port);
     report(stderr, 0, &loop.counters, ps.tx_errors, port.rx_dropped, &times);
