@@ -5,31 +5,20 @@ the safe state while its inputs are gone, and control again once they are back
 (DESIGN.md section 8, issue 10 item 7)."""
 from __future__ import annotations
 
-import glob
 import json
-import socket
 import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from vcan_support import needs_vcan
 
 from wetclutch import canlog, replay
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _host_has_can() -> bool:
-    try:
-        socket.socket(socket.AF_CAN, socket.SOCK_RAW, socket.CAN_RAW).close()
-        return True
-    except (AttributeError, OSError):
-        return False
-
-
-pytestmark = pytest.mark.skipif(
-    not glob.glob("/boot/vmlinuz-*") and not _host_has_can(),
-    reason="no SocketCAN in the host kernel and no /boot/vmlinuz-* for a QEMU guest (bash scripts/setup.sh)")
+pytestmark = needs_vcan
 
 GUEST = r"""
 set -u

@@ -1,30 +1,17 @@
 """hil/vcan_run.sh: a candump capture round trip on vcan0 (natively or in a QEMU guest)."""
 from __future__ import annotations
 
-import glob
-import socket
 import subprocess
 from pathlib import Path
 
 import pytest
+from vcan_support import needs_vcan
 
 ROOT = Path(__file__).resolve().parents[2]
 RUNNER = ROOT / "hil" / "vcan_run.sh"
 
 
-def _host_has_can() -> bool:
-    try:
-        socket.socket(socket.AF_CAN, socket.SOCK_RAW, socket.CAN_RAW).close()
-        return True
-    except (AttributeError, OSError):
-        return False
-
-
-pytestmark = pytest.mark.skipif(
-    not glob.glob("/boot/vmlinuz-*") and not _host_has_can(),
-    reason="no SocketCAN in the host kernel and no /boot/vmlinuz-* for a QEMU guest "
-    "(run 'bash scripts/setup.sh' as root)",
-)
+pytestmark = needs_vcan
 
 FRAMES = ["123#DEADBEEF", "7FF#0102030405060708", "010#"]
 
