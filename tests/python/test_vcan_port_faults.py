@@ -10,7 +10,6 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
-import pytest
 from vcan_support import needs_vcan
 
 from wetclutch import canlog, replay

@@ -4,7 +4,6 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
-import pytest
 from vcan_support import needs_vcan
 
 ROOT = Path(__file__).resolve().parents[2]
