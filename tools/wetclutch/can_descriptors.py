@@ -244,22 +244,27 @@ def _encode(m: Message) -> str:
         lines.append("    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);")
         lines.append("    msg.crc = 0u;")
     lines += [f"    if ({PREFIX}_{m.snake}_pack(dst, &msg, size) < 0) {{", "        return WC_CAN_ERR_SIZE;", "    }"]
-    status = m.of("status")
-    if status:
-        # The status signals are contiguous little-endian bits from status_start:
+    layout = _status_layout(m)
+    if layout:
         # OR the whole word into its bytes (cantools' per-bit fields stay 0).
-        mask = (1 << len(status)) - 1
-        shift = m.status_start % 8
-        first_byte = m.status_start // 8
-        last_byte = (m.status_start + len(status) - 1) // 8
-        lines.append(f"    const uint32_t status_bits = ((uint32_t)src->status & 0x{mask:X}u) << {shift};"
-                     f"  /* frame bits {m.status_start}..{m.status_start + len(status) - 1} */")
-        for b in range(first_byte, last_byte + 1):
-            lines.append(f"    dst[{b}] = (uint8_t)(dst[{b}] | (uint8_t)(status_bits >> {8 * (b - first_byte)}));")
+        mask, shift, first, last, bits = layout
+        lines.append(f"    const uint32_t status_bits = ((uint32_t)src->status & 0x{mask:X}u) << {shift};  /* {bits} */")
+        for b in range(first, last + 1):
+            lines.append(f"    dst[{b}] = (uint8_t)(dst[{b}] | (uint8_t)(status_bits >> {8 * (b - first)}));")
     if m.e2e:
         lines.append(f"    (void)wc_e2e_protect({m.upper}_FRAME_ID, dst, size);")
     lines += ["    return result;", "}"]
     return "\n".join(lines)
+
+
+def _status_layout(m: Message):
+    """(mask, shift, first byte, last byte, comment) of the status word: the Status*
+    signals are contiguous little-endian bits from status_start; None without them."""
+    n = len(m.of("status"))
+    if n == 0:
+        return None
+    return ((1 << n) - 1, m.status_start % 8, m.status_start // 8, (m.status_start + n - 1) // 8,
+            f"frame bits {m.status_start}..{m.status_start + n - 1}")
 
 
 def _decode(m: Message) -> str:
@@ -281,17 +286,13 @@ def _decode(m: Message) -> str:
         lines.append(f"    if (!{PREFIX}_{m.snake}_{s.snake}_is_in_range(msg.{s.snake})) {{")
         lines.append("        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);")
         lines.append("    }")
-    status = m.of("status")
-    if status:
-        # The contiguous little-endian status bits, read as one word (the mirror of encode).
-        mask = (1 << len(status)) - 1
-        shift = m.status_start % 8
-        first_byte = m.status_start // 8
-        last_byte = (m.status_start + len(status) - 1) // 8
-        for b in range(first_byte, last_byte + 1):
-            lines.append(f"    status |= (uint32_t)src[{b}] << {8 * (b - first_byte)};")
-        lines.append(f"    dst->status = (uint16_t)((status >> {shift}) & 0x{mask:X}u);"
-                     f"  /* frame bits {m.status_start}..{m.status_start + len(status) - 1} */")
+    layout = _status_layout(m)
+    if layout:
+        # The word read back from its bytes (the mirror of encode).
+        mask, shift, first, last, bits = layout
+        for b in range(first, last + 1):
+            lines.append(f"    status |= (uint32_t)src[{b}] << {8 * (b - first)};")
+        lines.append(f"    dst->status = (uint16_t)((status >> {shift}) & 0x{mask:X}u);  /* {bits} */")
     if m.e2e:
         lines.append("    dst->alive_counter = msg.alive_counter;")
     lines += ["    return result;", "}"]
