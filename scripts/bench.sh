@@ -85,9 +85,9 @@ client-request overhead ({base} instructions) subtracted.
 |---|---:|---:|---:|---:|---|
 {row("wc_clutch_step", calls("wc_clutch_step"))}
 {row("wc_inverse", calls("wc_inverse"))}
-{row("wc_inverse, bisection (status 0)", calls("wc_inverse", status("0x00")))}
+{row("wc_inverse, solving (status 0)", calls("wc_inverse", status("0x00")))}
 {row("wc_inverse, below drag", calls("wc_inverse", status("0x01")))}
 {row("wc_inverse, saturated", calls("wc_inverse", status("0x02")))}
 
-Bisection iterations seen: median {statistics.median_low(iters)}, worst {max(iters)}.""")
+Newton steps seen: median {statistics.median_low(iters)}, worst {max(iters)}.""")
 EOF
