@@ -325,6 +325,58 @@ static void test_step_uses_the_temperature_estimate(void **state)
     WC_CHECK_CLOSE("mu_f at 90 degC", 0, out.model.mu_f, mu_f, 2e-6, 0.0);
 }
 
+/* The thermal envelope (DESIGN section 8) against the double-precision
+ * reference (tests/vectors: wc_golden_hot_clutch, every 10th step of
+ * vectors.hot_clutch_profile): a hot clutch under torque control passes the
+ * over-temperature threshold, is held at WC_THETA_MAX_degC, then cools
+ * released. Tolerances: theta 0.2 K (the heat input is the float torque
+ * model's, within 1e-4 of the reference's: at 120 kW that is 12 W, 0.07 K at
+ * equilibrium, x3); current 2e-3 relative (1e-4 of the inverse plus mu_f's
+ * temperature slope, mu3/theta2 = 0.74 %/K, times those 0.2 K); the
+ * over-temperature bit exactly, except within 1 K of 200 or 190 degC, where a
+ * step's float rounding may move the crossing by one step. */
+static void test_thermal_envelope_matches_golden(void **state)
+{
+    (void)state;
+    const wc_calibration_t *cal = &wc_table1_calibration;
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, cal, 120.0f), WC_CAL_OK);
+    const size_t rows = WC_TEST_COUNT(wc_golden_hot_clutch);
+    const uint32_t steps = (uint32_t)wc_golden_hot_clutch[rows - 1u].step + 1u;
+    const uint32_t every = (uint32_t)wc_golden_hot_clutch[1].step;
+    size_t row = 0u;
+    int over_rows = 0;
+    for (uint32_t k = 0u; k < steps; ++k) {
+        const bool hot = k < 1200u;  /* 1.2 s at 1 ms */
+        wc_step_input_t in;
+        memset(&in, 0, sizeof in);
+        in.slip_rad_s = hot ? 300.0f : 0.0f;
+        in.theta_oil_degC = 120.0f;
+        in.theta_housing_degC = 120.0f;
+        in.torque_request_Nm = hot ? 400.0f : 0.0f;
+        in.mode = hot ? WC_MODE_TORQUE : WC_MODE_OPEN;
+        wc_step_output_t out;
+        const wc_status_t status = wc_clutch_step(&clutch, &in, &out);
+        WC_CHECK(clutch.theta_degC <= WC_THETA_MAX_degC, "step %u: %g degC", (unsigned)k, (double)clutch.theta_degC);
+        if ((k % every) != 0u) { continue; }
+        const wc_golden_hot_clutch_t *g = &wc_golden_hot_clutch[row++];
+        WC_CHECK((uint32_t)g->step == k, "golden row %zu is step %g, expected %u", row - 1u, g->step, (unsigned)k);
+        WC_CHECK_CLOSE("theta_degC", (long)k, out.theta_degC, g->theta_degC, 0.0, 0.2);
+        WC_CHECK_CLOSE("current_mA", (long)k, out.current_mA, g->current_mA, 2e-3, 1e-3);
+        const bool over = (status & WC_STATUS_OVER_TEMPERATURE) != 0u;
+        const bool near = (fabs(g->theta_degC - (double)WC_THETA_OVER_degC) < 1.0) ||
+                          (fabs(g->theta_degC - (double)(WC_THETA_OVER_degC - WC_THETA_OVER_HYSTERESIS_K)) < 1.0);
+        if (!near) {
+            WC_CHECK(over == ((g->status & (int)WC_STATUS_OVER_TEMPERATURE) != 0), "step %u: over-temperature %d",
+                     (unsigned)k, (int)over);
+        }
+        over_rows += over ? 1 : 0;
+    }
+    assert_int_equal(row, rows);
+    WC_CHECK(over_rows > 10, "the series never reached the over-temperature threshold (%d rows)", over_rows);
+    WC_CHECK((clutch.over_temperature == false), "still over-temperature after cooling");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -334,6 +386,7 @@ int main(void)
         cmocka_unit_test(test_all_inputs_bad_outputs_finite),
         cmocka_unit_test(test_closed_loop_reaches_request),
         cmocka_unit_test(test_two_instances_do_not_interfere),
+        cmocka_unit_test(test_thermal_envelope_matches_golden),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

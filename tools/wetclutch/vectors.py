@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import atomic, reference
+from . import atomic, model, reference
 from .calibration import Calibration
 from .lut import banner
 
@@ -32,6 +32,22 @@ def thermal_profile(cal: Calibration):
     return {"t_s": t, "slip_rpm": slip, "torque_Nm": torque, "theta_oil_degC": oil, "theta_housing_degC": housing}
 
 
+HOT_EVERY = 10  # rows of the hot-clutch series kept in the header (the C test steps every period)
+
+
+def hot_clutch_profile(cal: Calibration):
+    """The thermal envelope (DESIGN section 8): 1.2 s of torque control at 300 rad/s,
+    400 Nm requested, oil and housing at 120 degC (the estimate passes the
+    over-temperature threshold and is held at the envelope's 250 degC), then
+    1.6 s released at standstill (it cools below the threshold minus the hysteresis)."""
+    n = int(round(2.8 / cal.period))
+    t = np.arange(n) * cal.period
+    hot = t < 1.2
+    return {"step": np.arange(n, dtype=float), "slip_rpm": np.where(hot, 300.0 / model.RAD_S_PER_RPM, 0.0),
+            "theta_oil_degC": np.full(n, 120.0), "theta_housing_degC": np.full(n, 120.0),
+            "torque_request_Nm": np.where(hot, 400.0, 0.0), "mode": np.where(hot, model.MODE_TORQUE, model.MODE_OPEN)}
+
+
 def _c_double(x: float) -> str:
     return f"{x:.9g}" if math.isfinite(x) else "NAN"
 
@@ -53,6 +69,11 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
     iout = reference.inverse(cal, iin)
     thin = thermal_profile(cal)
     thout = reference.thermal(cal, thin)
+    hin = hot_clutch_profile(cal)
+    hout = model.clutch_steps(cal, hin["slip_rpm"], hin["theta_oil_degC"], hin["theta_housing_degC"],
+                              hin["torque_request_Nm"], mode=hin["mode"], theta_start_degC=120.0)
+    keep = np.arange(0, hin["step"].size, HOT_EVERY)
+    hot = {k: np.asarray(v)[keep] for k, v in {**hin, **hout}.items()}
     text = (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/model.py),\n"
@@ -63,13 +84,20 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
         "typedef struct { double slip_rpm, theta_degC, torque_Nm, force_N, pressure_kPa, current_mA; int status; }"
         " wc_golden_inverse_t;\n"
         "typedef struct { double t_s, slip_rpm, torque_Nm, theta_oil_degC, theta_housing_degC, theta_degC; }"
-        " wc_golden_thermal_t;\n\n"
+        " wc_golden_thermal_t;\n"
+        "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, theta_degC; int status; }"
+        " wc_golden_hot_clutch_t;\n\n"
         + _table("wc_golden_torque", "wc_golden_torque_t", {**tin, **tout},
                  ("slip_rpm", "theta_degC", "force_N", "torque_Nm", "coulomb_Nm", "viscous_Nm", "hbar_um", "mu_f"))
         + "\n" + _table("wc_golden_inverse", "wc_golden_inverse_t", {**iin, **iout},
                         ("slip_rpm", "theta_degC", "torque_Nm", "force_N", "pressure_kPa", "current_mA", "status"))
         + "\n" + _table("wc_golden_thermal", "wc_golden_thermal_t", {**thin, **thout},
                         ("t_s", "slip_rpm", "torque_Nm", "theta_oil_degC", "theta_housing_degC", "theta_degC"))
+        + f"\n/* wc_clutch_step on the hot-clutch series (vectors.hot_clutch_profile: oil = housing =\n"
+        f" * 120 degC, start 120 degC; torque control before step {int(round(1.2 / cal.period))}, open after),\n"
+        f" * every {HOT_EVERY}th step; theta_degC is the estimate used in that step. */\n"
+        + _table("wc_golden_hot_clutch", "wc_golden_hot_clutch_t", hot,
+                 ("step", "slip_rpm", "torque_request_Nm", "current_mA", "theta_degC", "status"))
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )
     out_dir.mkdir(parents=True, exist_ok=True)
