@@ -110,17 +110,22 @@ int wc_socketcan_reopen(wc_socketcan_t *port)
     return 0;
 }
 
-int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t timeout_us)
+int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t timeout_us, int wake_fd)
 {
-    struct pollfd pfd = { .fd = port->fd, .events = POLLIN, .revents = 0 };
+    struct pollfd pfds[2] = { { .fd = port->fd, .events = POLLIN, .revents = 0 },
+                              { .fd = wake_fd, .events = POLLIN, .revents = 0 } };  /* fd < 0: ignored */
+    struct pollfd *pfd = &pfds[0];
     struct timespec timeout = { .tv_sec = (time_t)(timeout_us / 1000000), .tv_nsec = (long)(timeout_us % 1000000) * 1000L };
-    const int ready = ppoll(&pfd, 1, (timeout_us < 0) ? NULL : &timeout, NULL);  /* ns resolution, unlike poll */
+    const int ready = ppoll(pfds, 2, (timeout_us < 0) ? NULL : &timeout, NULL);  /* ns resolution, unlike poll */
     if (ready < 0) {
         if (errno == EINTR) { return WC_SOCKETCAN_NONE; }
         (void)fail(port, "poll", errno, "");
         return WC_SOCKETCAN_FAILED;
     }
     if (ready == 0) { return WC_SOCKETCAN_NONE; }
+    if ((pfd->revents & (POLLIN | POLLERR)) == 0) {
+        return ((pfds[1].revents & POLLIN) != 0) ? WC_SOCKETCAN_WAKE : WC_SOCKETCAN_NONE;
+    }
     struct can_frame raw;
     char control[CMSG_SPACE(sizeof(uint32_t))];
     struct iovec iov = { .iov_base = &raw, .iov_len = sizeof raw };

@@ -26,6 +26,7 @@ typedef struct {
 #define WC_SOCKETCAN_NONE 0           /* timeout or signal */
 #define WC_SOCKETCAN_BUS_ERROR 2      /* a CAN error frame: counted in bus_errors, nothing in *frame */
 #define WC_SOCKETCAN_DOWN (-2)        /* the interface went down or away: reopen later */
+#define WC_SOCKETCAN_WAKE 3           /* wake_fd became readable (the caller's timer): nothing read from CAN */
 #define WC_SOCKETCAN_FAILED (-1)      /* any other error */
 
 /* Open and bind; filter_ids (count entries, standard 11-bit ids) become the
@@ -39,8 +40,10 @@ int wc_socketcan_open(wc_socketcan_t *port, const char *iface, const uint32_t *f
  * reject and count them), WC_SOCKETCAN_NONE, WC_SOCKETCAN_BUS_ERROR (an error
  * frame: bus_errors and bus_off updated), WC_SOCKETCAN_DOWN (ENETDOWN,
  * ENODEV, ENXIO: the interface went down; wc_socketcan_reopen later) or
- * WC_SOCKETCAN_FAILED, with port->error set for the last two. */
-int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t timeout_us);
+ * WC_SOCKETCAN_FAILED, with port->error set for the last two. wake_fd >= 0
+ * (e.g. a timerfd) is polled too: WC_SOCKETCAN_WAKE when it is readable
+ * (the caller reads it); a pending frame is returned first. */
+int wc_socketcan_receive(wc_socketcan_t *port, wc_can_frame_t *frame, int64_t timeout_us, int wake_fd);
 
 /* Send one frame without blocking (a full transmit queue at bus-off must not
  * stall the loop). Returns 0, or -1 with port->error set: the caller counts

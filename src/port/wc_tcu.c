@@ -1,7 +1,7 @@
 /* wc_tcu: the TCU program. Runs the portable frame loop (wc_loop) of one
  * clutch on a SocketCAN interface.
- *   --clock timer  steps at deadlines a fixed period apart (the receive wait,
- *                  ppoll, is bounded by the next deadline), counts misses
+ *   --clock timer  steps at absolute deadlines a fixed period apart (a periodic
+ *                  timerfd on CLOCK_MONOTONIC polled with the socket), counts misses
  *   --clock frame  one step per received ClutchSensors frame, so that replaying
  *                  one log twice gives byte-identical output frames
  * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit seconds without a
@@ -13,6 +13,8 @@
 #include <getopt.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <sys/timerfd.h>
+#include <unistd.h>
 #include <stdbool.h>
 #include <signal.h>
 #include <stdint.h>
@@ -238,15 +240,42 @@ typedef struct {
  * kernel drops and failed sends are reported to the loop as they happen
  * (StatusFrameLost / StatusBusError in the next VfsCommand). Returns the
  * exit status. */
+/* The timer clock: a periodic timerfd on CLOCK_MONOTONIC armed at an absolute
+ * first deadline, so every deadline is start + k periods, kept by the kernel
+ * (no drift, no wait computed from a "now" that is already late); reading it
+ * gives the expirations since the last read: more than one is a miss. */
+static int timer_open(int64_t period_ns)
+{
+    const int fd = timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
+    if (fd < 0) { return -1; }
+    struct timespec start;
+    (void)clock_gettime(CLOCK_MONOTONIC, &start);
+    const int64_t first_ns = (int64_t)start.tv_sec * 1000000000LL + start.tv_nsec + period_ns;
+    struct itimerspec spec;
+    spec.it_value.tv_sec = (time_t)(first_ns / 1000000000LL);
+    spec.it_value.tv_nsec = (long)(first_ns % 1000000000LL);
+    spec.it_interval.tv_sec = (time_t)(period_ns / 1000000000LL);
+    spec.it_interval.tv_nsec = (long)(period_ns % 1000000000LL);
+    if (timerfd_settime(fd, TFD_TIMER_ABSTIME, &spec, NULL) != 0) {
+        (void)close(fd);
+        return -1;
+    }
+    return fd;
+}
+
 static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step_times_t *times, port_stats_t *ps)
 {
     int64_t last_rx = -1;  /* the idle timer starts with the first frame */
-    int64_t deadline = now_ns() + opt->period_ns;
     const wc_loop_clock_t clock = opt->frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
+    const int timer_fd = opt->frame_clock ? -1 : timer_open(opt->period_ns);
+    if (!opt->frame_clock && (timer_fd < 0)) {
+        fprintf(stderr, "wc_tcu: timerfd: %s\n", strerror(errno));
+        return 1;
+    }
     while (!stop_requested && (opt->max_steps == 0 || loop->counters.steps < opt->max_steps)) {
         wc_can_frame_t frame;
-        const int64_t wait_ns = opt->frame_clock ? 100000000LL : deadline - now_ns();
-        int got = (wait_ns > 0) ? wc_socketcan_receive(port, &frame, wait_ns / 1000) : WC_SOCKETCAN_NONE;
+        /* frame clock: wake every 100 ms for the idle and reopen checks; timer clock: the timerfd wakes */
+        int got = wc_socketcan_receive(port, &frame, 100000LL, timer_fd);
         if (got == WC_SOCKETCAN_FAILED) {
             fprintf(stderr, "wc_tcu: %s\n", port->error);
             return 1;
@@ -280,14 +309,14 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step
             return 0;
         }
         bool tick = false;
-        if (!opt->frame_clock && t >= deadline) {
-            tick = true;
-            deadline += opt->period_ns;
-            if (t >= deadline) {  /* late by a whole period or more: skip, count */
-                const int64_t missed = (t - deadline) / opt->period_ns + 1;
-                deadline += missed * opt->period_ns;
-                wc_loop_deadline_missed(loop, (uint32_t)missed);
+        if (got == WC_SOCKETCAN_WAKE) {
+            uint64_t expirations = 0u;
+            if ((read(timer_fd, &expirations, sizeof expirations) == (ssize_t)sizeof expirations) &&
+                (expirations > 0u)) {
+                tick = true;  /* one step per wake; the deadlines it slept through are misses */
+                if (expirations > 1u) { wc_loop_deadline_missed(loop, (uint32_t)(expirations - 1u)); }
             }
+            got = WC_SOCKETCAN_NONE;
         }
         const int64_t t0 = now_ns();
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
@@ -304,6 +333,7 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step
         }
         record(times, now_ns() - t0);
     }
+    if (timer_fd >= 0) { (void)close(timer_fd); }
     return 0;
 }
 
