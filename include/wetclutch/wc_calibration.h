@@ -42,7 +42,10 @@ typedef struct {
     wc_film_table_t film;
 } wc_calibration_t;
 
-/* Which field an invalid calibration fails on (0 = valid). */
+/* Which field an invalid calibration fails on (0 = valid). A field's code:
+ * NaN, infinite, or outside its limit (below); the relations between fields
+ * have their own codes after WC_CAL_FILM_AXIS_NOT_MONOTONE, or the code of the
+ * field they are checked with. wc_cal_error_name names the field(s). */
 typedef enum {
     WC_CAL_OK = 0,
     WC_CAL_NULL,
@@ -68,15 +71,102 @@ typedef enum {
     WC_CAL_VFS_TIME_CONSTANT,
     WC_CAL_RETURN_SPRING_FORCE,
     WC_CAL_VFS_CURRENT_MIN,
-    WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum, or a piston force above WC_FORCE_MAX_N */
+    WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum, a piston force K i_max A_p above
+                                 * WC_FORCE_MAX_N, or not above the spring force F_s (cannot apply) */
     WC_CAL_CONTROL_PERIOD,
     WC_CAL_FILM_TABLE,          /* missing arrays, bad length, non-finite entry */
     WC_CAL_FILM_AXIS_NOT_MONOTONE,
+    WC_CAL_CONDUCTANCE_SUM,     /* k1 + k2 below WC_CAL_LIMIT_CONDUCTANCE_SUM_MIN_W_per_K */
+    WC_CAL_THERMAL_TIME_CONSTANT, /* C / (k1 + k2) outside [control period, WC_CAL_LIMIT_TIME_CONSTANT_MAX_s] */
+    WC_CAL_VISCOSITY_RANGE,     /* mu_v (eq. 2) not in (0, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s] on the domain */
+    WC_CAL_FRICTION_DOMAIN,     /* mu_f (eq. 18) not in (0, WC_CAL_LIMIT_MU_MAX] on the domain */
+    WC_CAL_FILM_RANGE,          /* h_bar outside [WC_CAL_LIMIT_FILM_HBAR_MIN_m, ..._MAX_m], or p_0 < 0 */
+    WC_CAL_FILM_NOT_MONOTONE,   /* slope > 0, h_bar not strictly decreasing, or Fritsch-Carlson violated */
+    WC_CAL_FILM_COVERAGE,       /* last node below the contact pressure at the maximum current */
     WC_CAL_ERRORS               /* number of codes, not an error */
 } wc_cal_error_t;
 
-/* Check every field: finite, positive where the physics needs it, film axis
- * strictly increasing. Returns the first failing field. */
+/* Limits of wc_calibration_check (DESIGN section 8, "Calibration validity").
+ * Together they prove, from the equations, that every output of every public
+ * function is finite and physical on the model's domain: theta in
+ * [WC_THETA_MIN_degC, WC_THETA_MAX_degC], |slip| <= WC_SLIP_MAX_rad_s, contact
+ * force <= WC_FORCE_MAX_N (wc_config.h). tools/wetclutch/calibration.py applies
+ * the same rules with the same numbers (LIMITS; tests/python/
+ * test_calibration_rules.py compares them with these). Each bound is far
+ * outside any real clutch pack; its reason: */
+/* R_o: a clutch disc, not a flywheel. R_eff < R_o, so the torque arm
+ * R_eff N_c <= 64 m and the sliding speed R_eff |dw| <= 1047 m/s. */
+#define WC_CAL_LIMIT_RADIUS_MAX_m 1.0f
+/* A_p: with K i_max A_p <= WC_FORCE_MAX_N it bounds the piston, not the force. */
+#define WC_CAL_LIMIT_PISTON_AREA_MAX_m2 1.0f
+/* A_f <= pi R_o^2: the lining cannot be larger than the face of the disc. */
+#define WC_CAL_LIMIT_PI 3.14159265f
+/* N_c: 1..64 friction pairs (an AT pack has 2..10). */
+#define WC_CAL_LIMIT_FRICTION_PAIRS_MAX 64u
+/* k1, k2 <= 1e5 W/K (a pack has ~100 W/K): the steady temperature
+ * (P + k1 th_oil + k2 th_housing) / (k1 + k2) stays far from overflow. */
+#define WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K 1e5f
+/* k1 + k2 >= 1e-3 W/K: the division by k1 + k2 (eq. 1 at rest) stays finite
+ * for the largest heat input (|T dw| <= ~2e19 W: 2e22 K before the envelope clamps). */
+#define WC_CAL_LIMIT_CONDUCTANCE_SUM_MIN_W_per_K 1e-3f
+/* C <= 1e7 J/K: 20 t of steel; a pack has ~300 J/K. */
+#define WC_CAL_LIMIT_HEAT_CAPACITY_MAX_J_per_K 1e7f
+/* C / (k1 + k2) <= 1e5 s (28 h): a slower observer never moves in a drive (its
+ * decay factor rounds to 1 in float); the lower bound is the control period
+ * (a thermal mode faster than one step is not resolved by the observer). */
+#define WC_CAL_LIMIT_TIME_CONSTANT_MAX_s 1e5f
+/* |b1|, |b2| <= 0.3 /K: b theta stays within +-75 on [-40, 250] degC, inside
+ * [-87, 88] where the model's exponential (src/model/wc_exp.c) is valid. */
+#define WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K 0.3f
+/* mu_v <= 100 Pa s on the domain (the paper's oil: 3.6 Pa s at -40 degC): it
+ * bounds the viscous torque R_eff N_c mu_v A_f v / h_bar. */
+#define WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s 100.0f
+/* mu1, mu2 in [1e-3, 1] and mu_f <= 1 on the domain (wet friction pairs:
+ * 0.05..0.2). The lower limit keeps mu_f > 0 in float: the Stribeck blend
+ * mu1 + (mu2 - mu1) e^-x rounds by ~1e-7, which would cancel a smaller
+ * mu1 or mu2 to 0. */
+#define WC_CAL_LIMIT_MU_MIN 1e-3f
+#define WC_CAL_LIMIT_MU_MAX 1.0f
+/* v_s in [1e-6, 100] m/s (the paper's 0.024 m/s): speed / v_s stays finite. */
+#define WC_CAL_LIMIT_STRIBECK_SPEED_MIN_m_s 1e-6f
+#define WC_CAL_LIMIT_STRIBECK_SPEED_MAX_m_s 100.0f
+/* theta2 >= 1 K: the normalization span of eq. 18 (the paper's 70 K); a
+ * smaller one makes mu3 (theta - theta1) / theta2 overflow for modest mu3. */
+#define WC_CAL_LIMIT_THETA2_MIN_K 1.0f
+/* K <= 1e6 Pa/mA (1 GPa at 1 A; the paper's 2300 Pa/mA). */
+#define WC_CAL_LIMIT_VFS_GAIN_MAX_Pa_per_mA 1e6f
+/* tau in [1e-4, 10] s (the paper's 0.06 s). */
+#define WC_CAL_LIMIT_VFS_TIME_CONSTANT_MIN_s 1e-4f
+#define WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s 10.0f
+/* F_s <= 1e5 N, the largest contact force the model takes (WC_FORCE_MAX_N). */
+#define WC_CAL_LIMIT_SPRING_FORCE_MAX_N 1e5f
+/* i_min, i_max <= 1e4 mA (10 A; a VFS takes ~1 A). */
+#define WC_CAL_LIMIT_CURRENT_MAX_mA 1e4f
+/* control period in [1e-4, 0.1] s (the paper's TCU: 1 ms). */
+#define WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s 1e-4f
+#define WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s 0.1f
+/* h_bar in [1e-9, 1e-3] m at every node: 1 nm (below it the viscous term
+ * mu_v A_f v / h_bar is not a film any more, and it bounds that term) to 1 mm
+ * (more than any clearance in a pack). The interpolant of a table that passes
+ * the Fritsch-Carlson test stays between its nodes, so these bound it too
+ * (in float within 20 % of the last node: tests/c/test_calibration.c). */
+#define WC_CAL_LIMIT_FILM_HBAR_MIN_m 1e-9f
+#define WC_CAL_LIMIT_FILM_HBAR_MAX_m 1e-3f
+/* Fritsch-Carlson (1980): with Delta_k = (h_k+1 - h_k) / (p_k+1 - p_k) < 0,
+ * alpha = s_k / Delta_k, beta = s_k+1 / Delta_k, alpha, beta >= 0 and
+ * alpha^2 + beta^2 <= 9 make the cubic Hermite on [p_k, p_k+1] monotone. */
+#define WC_CAL_LIMIT_FRITSCH_CARLSON 9.0f
+
+/* Check every field against the limits above, and the relations between
+ * fields that the equations need (DESIGN section 8): radii ordered, mu_v and
+ * mu_f within their bounds on the whole temperature x speed domain, finite
+ * thermal time constant, the piston can apply and stays below WC_FORCE_MAX_N,
+ * the film table strictly monotone with a monotone positive Hermite
+ * interpolant on every interval that reaches the contact pressure at the
+ * maximum current. NaN and infinities fail every rule. Returns the first
+ * failing check: each field against its range in declaration order, then the
+ * relations (in the order of the codes after WC_CAL_FILM_AXIS_NOT_MONOTONE,
+ * or the field they are reported on), then the film table. */
 wc_cal_error_t wc_calibration_check(const wc_calibration_t *cal);
 
 /* Name of the field for an error code ("outer_radius_m", ...), for logs. */

@@ -1,67 +1,221 @@
+/* wc_calibration_check: the rules of DESIGN section 8, "Calibration validity".
+ *
+ * What each rule proves (the limits and their reasons are in
+ * include/wetclutch/wc_calibration.h; tools/wetclutch/calibration.py applies
+ * the same rules). On the model's domain, theta in [WC_THETA_MIN_degC,
+ * WC_THETA_MAX_degC], |slip| <= WC_SLIP_MAX_rad_s, 0 <= F_c <= WC_FORCE_MAX_N:
+ *  - R_eff = 2/3 (Ro^2 + Ro Ri + Ri^2) / (Ro + Ri) lies in (Ri, Ro) <= 1 m, so
+ *    v = R_eff |dw| <= 1047 m/s and the torque arm R_eff N_c <= 64 m;
+ *  - eq. 2: |b theta| <= 75 keeps wc_exp in its domain; each term a e^(b theta)
+ *    is monotone, so mu_v lies between the sums of the terms' values at the
+ *    two ends, which must be > 0 and <= the limit;
+ *  - eq. 18: the Stribeck factor lies between mu1 and mu2 (in [1e-3, 1]); the
+ *    temperature factor is linear in theta, so it is positive on the domain
+ *    when it is at both ends, and mu_f <= max(mu1, mu2) times its larger end;
+ *  - eq. 1: k1 + k2 bounded away from 0 and a thermal time constant between
+ *    the control period and the limit give a finite steady state and a decay
+ *    factor in [1/e, 1];
+ *  - hydraulics: the piston applies (K i_max A_p > F_s) and its force stays
+ *    within WC_FORCE_MAX_N, the inverse's range;
+ *  - film: nodes in [h_min, h_max] and the Fritsch-Carlson condition on every
+ *    interval make the cubic Hermite monotone, hence between its nodes: h_bar
+ *    is positive and bounded wherever it is evaluated, and T_v = ... / h_bar
+ *    is finite; the table reaches the contact pressure at the maximum current.
+ * Every comparison is written so that NaN fails it. The fields are checked
+ * first, each against its range (declaration order), then the relations. */
 #include "wetclutch/wc_calibration.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 
-#include "wetclutch/wc_config.h"
+#include "wc_internal.h"
 
-static bool positive(float x) { return isfinite(x) && (x > 0.0f); }
-static bool nonnegative(float x) { return isfinite(x) && (x >= 0.0f); }
+/* x in [lo, hi]. False for NaN (every comparison with NaN is false), and for
+ * +-Inf when the bounds are finite. */
+static bool within(float x, float lo, float hi) { return (x >= lo) && (x <= hi); }
 
-static wc_cal_error_t check_film(const wc_film_table_t *t)
+static float larger(float a, float b) { return (a > b) ? a : b; }
+static float smaller(float a, float b) { return (a < b) ? a : b; }
+
+/* The range of each float field, in declaration order: [low, high], or
+ * (low, high] with low_open. The relations between fields come after. */
+typedef struct {
+    uint16_t offset;   /* offsetof(wc_calibration_t, field) */
+    uint8_t code;      /* wc_cal_error_t */
+    uint8_t low_open;
+    float low;
+    float high;
+} wc_field_limit_t;
+
+#define WC_FIELD(member, code, low_open, low, high) \
+    { (uint16_t)offsetof(wc_calibration_t, member), (uint8_t)(code), (low_open), (low), (high) }
+
+static const wc_field_limit_t field_limits[] = {
+    WC_FIELD(outer_radius_m, WC_CAL_OUTER_RADIUS, 1u, 0.0f, WC_CAL_LIMIT_RADIUS_MAX_m),
+    WC_FIELD(inner_radius_m, WC_CAL_INNER_RADIUS, 1u, 0.0f, FLT_MAX),           /* and < R_o */
+    WC_FIELD(friction_area_m2, WC_CAL_FRICTION_AREA, 1u, 0.0f, FLT_MAX),        /* and <= pi R_o^2 */
+    WC_FIELD(piston_area_m2, WC_CAL_PISTON_AREA, 1u, 0.0f, WC_CAL_LIMIT_PISTON_AREA_MAX_m2),
+    WC_FIELD(oil_conductance_W_per_K, WC_CAL_OIL_CONDUCTANCE, 1u, 0.0f, WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K),
+    WC_FIELD(housing_conductance_W_per_K, WC_CAL_HOUSING_CONDUCTANCE, 0u, 0.0f,
+             WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K),
+    WC_FIELD(heat_capacity_J_per_K, WC_CAL_HEAT_CAPACITY, 1u, 0.0f, WC_CAL_LIMIT_HEAT_CAPACITY_MAX_J_per_K),
+    /* mu_v(0 degC) = a1 + a2: a coefficient above the mu_v limit fails anyway */
+    WC_FIELD(viscosity_a1_Pa_s, WC_CAL_VISCOSITY_A1, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s),
+    WC_FIELD(viscosity_b1_per_K, WC_CAL_VISCOSITY_B1, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K,
+             WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K),
+    WC_FIELD(viscosity_a2_Pa_s, WC_CAL_VISCOSITY_A2, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s),
+    WC_FIELD(viscosity_b2_per_K, WC_CAL_VISCOSITY_B2, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K,
+             WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K),
+    WC_FIELD(mu1, WC_CAL_MU1, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX),
+    WC_FIELD(mu2, WC_CAL_MU2, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX),
+    WC_FIELD(mu3, WC_CAL_MU3, 0u, -FLT_MAX, FLT_MAX),                           /* finite */
+    WC_FIELD(stribeck_speed_m_s, WC_CAL_STRIBECK_SPEED, 0u, WC_CAL_LIMIT_STRIBECK_SPEED_MIN_m_s,
+             WC_CAL_LIMIT_STRIBECK_SPEED_MAX_m_s),
+    WC_FIELD(theta1_degC, WC_CAL_THETA1, 0u, WC_THETA_MIN_degC, WC_THETA_MAX_degC),
+    WC_FIELD(theta2_K, WC_CAL_THETA2, 0u, WC_CAL_LIMIT_THETA2_MIN_K, FLT_MAX),
+    WC_FIELD(vfs_gain_Pa_per_mA, WC_CAL_VFS_GAIN, 1u, 0.0f, WC_CAL_LIMIT_VFS_GAIN_MAX_Pa_per_mA),
+    WC_FIELD(vfs_time_constant_s, WC_CAL_VFS_TIME_CONSTANT, 0u, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MIN_s,
+             WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s),
+    WC_FIELD(return_spring_force_N, WC_CAL_RETURN_SPRING_FORCE, 0u, 0.0f, WC_CAL_LIMIT_SPRING_FORCE_MAX_N),
+    WC_FIELD(vfs_current_min_mA, WC_CAL_VFS_CURRENT_MIN, 0u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA),
+    WC_FIELD(vfs_current_max_mA, WC_CAL_VFS_CURRENT_MAX, 1u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA), /* and > i_min */
+    WC_FIELD(control_period_s, WC_CAL_CONTROL_PERIOD, 0u, WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s,
+             WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s),
+};
+
+/* Every float field has its range: the float fields fill the struct up to
+ * the film table, but for friction_pairs (checked after piston_area_m2). */
+WC_STATIC_ASSERT(sizeof field_limits / sizeof field_limits[0] ==
+                     (offsetof(wc_calibration_t, film) - sizeof(uint32_t)) / sizeof(float),
+                 every_float_field_has_a_range);
+WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) <= UINT16_MAX, field_offsets_fit_uint16);
+
+static wc_cal_error_t check_fields(const wc_calibration_t *cal)
 {
+    for (size_t i = 0u; i < sizeof field_limits / sizeof field_limits[0]; ++i) {
+        const wc_field_limit_t *f = &field_limits[i];
+        float x;
+        memcpy(&x, (const unsigned char *)cal + f->offset, sizeof x);
+        const bool above_low = (f->low_open != 0u) ? (x > f->low) : (x >= f->low);
+        if (!above_low || !(x <= f->high)) { return (wc_cal_error_t)f->code; }
+        if ((f->code == WC_CAL_PISTON_AREA) &&
+            ((cal->friction_pairs == 0u) || (cal->friction_pairs > WC_CAL_LIMIT_FRICTION_PAIRS_MAX))) {
+            return WC_CAL_FRICTION_PAIRS;  /* in declaration order, after A_p */
+        }
+    }
+    return WC_CAL_OK;
+}
+
+/* One term a e^(b theta) of eq. 2 at both ends of the domain, added to the
+ * running lower and upper bounds of mu_v (the term is monotone in theta). */
+static void add_viscosity_term(float a, float b, float *low, float *high)
+{
+    const float at_min = a * wc_exp(b * WC_THETA_MIN_degC);
+    const float at_max = a * wc_exp(b * WC_THETA_MAX_degC);
+    *low += smaller(at_min, at_max);
+    *high += larger(at_min, at_max);
+}
+
+/* The temperature factor of eq. 18, written as wc_friction_coefficient computes it. */
+static float friction_temperature_factor(const wc_calibration_t *cal, float theta_degC)
+{
+    return 1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K;
+}
+
+/* The rules between fields, each after the last field it involves. */
+static wc_cal_error_t check_relations(const wc_calibration_t *cal)
+{
+    const float ro = cal->outer_radius_m;
+    if (!(cal->inner_radius_m < ro)) { return WC_CAL_INNER_RADIUS; }
+    if (!(cal->friction_area_m2 <= WC_CAL_LIMIT_PI * ro * ro)) { return WC_CAL_FRICTION_AREA; }
+    const float k_W_per_K = cal->oil_conductance_W_per_K + cal->housing_conductance_W_per_K;
+    if (!(k_W_per_K >= WC_CAL_LIMIT_CONDUCTANCE_SUM_MIN_W_per_K)) { return WC_CAL_CONDUCTANCE_SUM; }
+
+    float low = 0.0f;
+    float high = 0.0f;
+    add_viscosity_term(cal->viscosity_a1_Pa_s, cal->viscosity_b1_per_K, &low, &high);
+    add_viscosity_term(cal->viscosity_a2_Pa_s, cal->viscosity_b2_per_K, &low, &high);
+    if (!(low > 0.0f) || !(high <= WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s)) { return WC_CAL_VISCOSITY_RANGE; }
+
+    /* linear in theta: positive on the domain iff positive at both ends */
+    const float at_min = friction_temperature_factor(cal, WC_THETA_MIN_degC);
+    const float at_max = friction_temperature_factor(cal, WC_THETA_MAX_degC);
+    if (!(at_min > 0.0f) || !(at_max > 0.0f) ||
+        !(larger(cal->mu1, cal->mu2) * larger(at_min, at_max) <= WC_CAL_LIMIT_MU_MAX)) {
+        return WC_CAL_FRICTION_DOMAIN;
+    }
+
+    /* The inverse's iteration bound assumes the force range stays below
+     * WC_FORCE_MAX_N (2^WC_INVERSE_MAX_ITERATIONS halvings reach the tolerance),
+     * and a piston that cannot overcome its spring never applies the clutch. */
+    const float piston_force_N = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2;
+    if (!(cal->vfs_current_max_mA > cal->vfs_current_min_mA) || !(piston_force_N <= WC_FORCE_MAX_N) ||
+        !(piston_force_N - cal->return_spring_force_N > 0.0f)) {
+        return WC_CAL_VFS_CURRENT_MAX;
+    }
+
+    /* eq. 1: C / (k1 + k2) */
+    const float time_constant_s = cal->heat_capacity_J_per_K / k_W_per_K;
+    if (!within(time_constant_s, cal->control_period_s, WC_CAL_LIMIT_TIME_CONSTANT_MAX_s)) {
+        return WC_CAL_THERMAL_TIME_CONSTANT;
+    }
+    return WC_CAL_OK;
+}
+
+static wc_cal_error_t check_film(const wc_calibration_t *cal)
+{
+    const wc_film_table_t *t = &cal->film;
     if ((t->pressure_Pa == NULL) || (t->hbar_m == NULL) || (t->slope_m_per_Pa == NULL) ||
         (t->length < 2u) || (t->length > WC_FILM_MAX_NODES)) {
         return WC_CAL_FILM_TABLE;
     }
-    for (uint32_t i = 0u; i < t->length; ++i) { /* bounded by WC_FILM_MAX_NODES */
-        if (!nonnegative(t->pressure_Pa[i]) || !positive(t->hbar_m[i]) || !isfinite(t->slope_m_per_Pa[i]) ||
-            (t->slope_m_per_Pa[i] > 0.0f)) { /* h_bar falls as p_c rises */
-            return WC_CAL_FILM_TABLE;
-        }
-        if ((i > 0u) && !(t->pressure_Pa[i] > t->pressure_Pa[i - 1u])) {
-            return WC_CAL_FILM_AXIS_NOT_MONOTONE;
-        }
+    const float *p = t->pressure_Pa;
+    const float *h = t->hbar_m;
+    const float *s = t->slope_m_per_Pa;
+    const uint32_t n = t->length;
+    /* Each loop is bounded by WC_FILM_MAX_NODES (n <= it, checked above); one
+     * rule at a time over the whole table, as calibration.film_problem does. */
+    for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
+        if (!isfinite(p[i]) || !isfinite(h[i]) || !isfinite(s[i])) { return WC_CAL_FILM_TABLE; }
     }
+    for (uint32_t i = 1u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
+        if (!(p[i] > p[i - 1u])) { return WC_CAL_FILM_AXIS_NOT_MONOTONE; }
+    }
+    if (!(p[0] >= 0.0f)) { return WC_CAL_FILM_RANGE; }  /* a contact pressure is not negative */
+    for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
+        if (!within(h[i], WC_CAL_LIMIT_FILM_HBAR_MIN_m, WC_CAL_LIMIT_FILM_HBAR_MAX_m)) { return WC_CAL_FILM_RANGE; }
+    }
+    for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
+        if (!(s[i] <= 0.0f)) { return WC_CAL_FILM_NOT_MONOTONE; }  /* h_bar falls as p_c rises */
+    }
+    for (uint32_t k = 0u; (k < WC_FILM_MAX_NODES) && (k + 1u < n); ++k) {
+        const float delta = (h[k + 1u] - h[k]) / (p[k + 1u] - p[k]);
+        if (!(delta < 0.0f)) { return WC_CAL_FILM_NOT_MONOTONE; }  /* the data strictly decreasing */
+        /* Fritsch-Carlson: alpha, beta >= 0 (slopes <= 0, delta < 0) and
+         * alpha^2 + beta^2 <= 9: the cubic Hermite on the interval is monotone. */
+        const float alpha = s[k] / delta;
+        const float beta = s[k + 1u] / delta;
+        if (!(alpha * alpha + beta * beta <= WC_CAL_LIMIT_FRITSCH_CARLSON)) { return WC_CAL_FILM_NOT_MONOTONE; }
+    }
+    /* The table reaches the contact pressure at the maximum current (the force
+     * wc_model_init derives); beyond its last node the film is held constant. */
+    const float force_max_N =
+        cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 - cal->return_spring_force_N;
+    if (!(p[n - 1u] >= force_max_N / cal->friction_area_m2)) { return WC_CAL_FILM_COVERAGE; }
     return WC_CAL_OK;
 }
 
 wc_cal_error_t wc_calibration_check(const wc_calibration_t *cal)
 {
     if (cal == NULL) { return WC_CAL_NULL; }
-    if (!positive(cal->outer_radius_m)) { return WC_CAL_OUTER_RADIUS; }
-    if (!positive(cal->inner_radius_m) || !(cal->inner_radius_m < cal->outer_radius_m)) { return WC_CAL_INNER_RADIUS; }
-    if (!positive(cal->friction_area_m2)) { return WC_CAL_FRICTION_AREA; }
-    if (!positive(cal->piston_area_m2)) { return WC_CAL_PISTON_AREA; }
-    if ((cal->friction_pairs == 0u) || (cal->friction_pairs > 64u)) { return WC_CAL_FRICTION_PAIRS; }
-    if (!positive(cal->oil_conductance_W_per_K)) { return WC_CAL_OIL_CONDUCTANCE; }
-    if (!nonnegative(cal->housing_conductance_W_per_K)) { return WC_CAL_HOUSING_CONDUCTANCE; }
-    if (!positive(cal->heat_capacity_J_per_K)) { return WC_CAL_HEAT_CAPACITY; }
-    if (!nonnegative(cal->viscosity_a1_Pa_s)) { return WC_CAL_VISCOSITY_A1; }
-    if (!isfinite(cal->viscosity_b1_per_K)) { return WC_CAL_VISCOSITY_B1; }
-    if (!nonnegative(cal->viscosity_a2_Pa_s)) { return WC_CAL_VISCOSITY_A2; }
-    if (!isfinite(cal->viscosity_b2_per_K)) { return WC_CAL_VISCOSITY_B2; }
-    if (!positive(cal->mu1)) { return WC_CAL_MU1; }
-    if (!positive(cal->mu2)) { return WC_CAL_MU2; }
-    if (!isfinite(cal->mu3)) { return WC_CAL_MU3; }
-    if (!positive(cal->stribeck_speed_m_s)) { return WC_CAL_STRIBECK_SPEED; }
-    if (!isfinite(cal->theta1_degC)) { return WC_CAL_THETA1; }
-    if (!positive(cal->theta2_K)) { return WC_CAL_THETA2; }
-    if (!positive(cal->vfs_gain_Pa_per_mA)) { return WC_CAL_VFS_GAIN; }
-    if (!positive(cal->vfs_time_constant_s)) { return WC_CAL_VFS_TIME_CONSTANT; }
-    if (!nonnegative(cal->return_spring_force_N)) { return WC_CAL_RETURN_SPRING_FORCE; }
-    if (!nonnegative(cal->vfs_current_min_mA)) { return WC_CAL_VFS_CURRENT_MIN; }
-    if (!positive(cal->vfs_current_max_mA) || !(cal->vfs_current_max_mA > cal->vfs_current_min_mA)) {
-        return WC_CAL_VFS_CURRENT_MAX;
-    }
-    /* The inverse's iteration bound assumes the force range stays below
-     * WC_FORCE_MAX_N (2^WC_INVERSE_MAX_ITERATIONS halvings reach the tolerance). */
-    if (!(cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 <= WC_FORCE_MAX_N)) {
-        return WC_CAL_VFS_CURRENT_MAX;
-    }
-    if (!positive(cal->control_period_s)) { return WC_CAL_CONTROL_PERIOD; }
-    return check_film(&cal->film);
+    wc_cal_error_t error = check_fields(cal);
+    if (error == WC_CAL_OK) { error = check_relations(cal); }
+    if (error == WC_CAL_OK) { error = check_film(cal); }
+    return error;
 }
 
 /* Indexed by wc_cal_error_t, in its order: a code added without a name fails to compile. */
@@ -94,6 +248,13 @@ static const char *const cal_error_names[] = {
     "control_period_s",
     "film (table arrays, length or entries)",
     "film.pressure_Pa (not strictly increasing)",
+    "oil_conductance_W_per_K + housing_conductance_W_per_K",
+    "heat_capacity_J_per_K / (oil_conductance_W_per_K + housing_conductance_W_per_K)",
+    "viscosity_a1_Pa_s..viscosity_b2_per_K (mu_v on the temperature domain)",
+    "mu1, mu2, mu3, theta1_degC, theta2_K (mu_f on the temperature domain)",
+    "film.hbar_m, film.pressure_Pa (outside the physical range)",
+    "film.hbar_m, film.slope_m_per_Pa (not monotone: Fritsch-Carlson)",
+    "film.pressure_Pa (last node below the contact pressure at vfs_current_max_mA)",
 };
 WC_STATIC_ASSERT(sizeof cal_error_names / sizeof cal_error_names[0] == (size_t)WC_CAL_ERRORS,
                  cal_error_names_cover_every_code);

@@ -8,7 +8,7 @@
  * the C library's expf over [-87, 88]: at most 2 ulp (the bound asserted).
  *
  * Domain: the arguments the model produces are -30..0 (Stribeck term, eq. 18)
- * and b theta for eq. 2, which the calibration check keeps within +-80.
+ * and b theta for eq. 2, which the calibration check keeps within +-75 (|b| <= 0.3 /K).
  * Below -87 the result is 0 (e^-87 = 1.6e-38, the smallest normal float is
  * 1.2e-38), above 88 it is e^88 (no overflow); NaN gives 0. */
 #include <math.h>

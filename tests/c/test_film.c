@@ -196,6 +196,10 @@ static void test_hermite_reproduces_a_cubic(void **state)
         cal.film.hbar_m = h;
         cal.film.slope_m_per_Pa = s;
         cal.film.length = lengths[l];
+        /* the table must reach the contact pressure at the maximum current: a spring that leaves
+         * half the last node's pressure to apply at 1000 mA */
+        cal.return_spring_force_N = cal.vfs_gain_Pa_per_mA * cal.vfs_current_max_mA * cal.piston_area_m2 -
+                                    0.5f * p[lengths[l] - 1u] * cal.friction_area_m2;
         assert_int_equal(wc_calibration_check(&cal), WC_CAL_OK);
         const double top = (double)p[lengths[l] - 1u];
         for (double q = 0.5; q < top; q += 3.7) {

@@ -16,6 +16,7 @@ DEFAULT_CAL = "tools/calibrations/table1.toml"
 
 
 def _cmd_lut(args) -> int:
+    lut.check_max_error(args.max_error)   # before any work: NaN or <= 0 would disable the check
     cal = calibration.load(args.calibration)
     name = args.name or Path(args.calibration).stem
     command = f"wetclutch lut {args.calibration} --out {args.out}" + (f" --name {args.name}" if args.name else "")

@@ -10,6 +10,8 @@ would need about 2000 nodes (24 KiB with the same three arrays).
 """
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +19,7 @@ import numpy as np
 
 from . import model
 from .atomic import Staged
-from .calibration import PARAMETERS, Calibration
+from .calibration import FILM_MAX_NODES, PARAMETERS, Calibration, film_problem
 
 FLOAT_BYTES = 4
 ARRAYS_PER_NODE = 3  # pressure, h_bar, slope
@@ -40,24 +42,35 @@ class TableError(Exception):
 
 
 def build_table(cal: Calibration) -> FilmTable:
-    h_min, h_max, _, _ = model.film_domain(cal)
-    h = np.linspace(h_max, h_min, int(cal.nodes))  # decreasing h = increasing p_c
-    table = FilmTable(
-        pressure_Pa=model.contact_pressure_Pa(cal, h),
-        hbar_m=model.film_thickness_m(cal, h),
-        slope_m_per_Pa=model.film_slope_m_per_Pa(cal, h),
-    )
-    check_table(table)
+    """The table of cal (its film_lut and contact sections), checked by the firmware's film rules."""
+    nodes = cal.nodes
+    if not (math.isfinite(nodes) and nodes == int(nodes) and 2 <= nodes <= FILM_MAX_NODES):   # before allocating
+        raise TableError(f"{cal.path}: parameter 'film_lut.nodes': {nodes!r} must be a whole number in"
+                         f" [2, {FILM_MAX_NODES}] (WC_FILM_MAX_NODES)")
+    with np.errstate(all="ignore"):   # an unusable calibration gives non-finite values, rejected below
+        h_min, h_max, _, _ = model.film_domain(cal)
+        h = np.linspace(h_max, h_min, int(nodes))  # decreasing h = increasing p_c
+        table = FilmTable(
+            pressure_Pa=model.contact_pressure_Pa(cal, h),
+            hbar_m=model.film_thickness_m(cal, h),
+            slope_m_per_Pa=model.film_slope_m_per_Pa(cal, h),
+        )
+    check_table(table, cal)
     return table
 
 
-def check_table(table: FilmTable) -> None:
-    """The axis must be strictly increasing, also after rounding to float32."""
-    for name, axis in (("float64", table.pressure_Pa), ("float32", table.pressure_Pa.astype(np.float32))):
-        if axis.size < 2 or not np.all(np.diff(axis) > 0):
-            raise TableError(f"film table pressure axis is not strictly increasing ({name})")
-    if not (np.all(np.isfinite(table.hbar_m)) and np.all(np.isfinite(table.slope_m_per_Pa))):
-        raise TableError("film table holds a non-finite value")
+def check_table(table: FilmTable, cal: Calibration | None = None) -> None:
+    """The firmware's film rules (calibration.film_problem) on the table as stored (float32), the axis
+    also strictly increasing before rounding; with cal, the table must reach the contact pressure at
+    the maximum current."""
+    where = f"{cal.path}: film table from the contact and film_lut sections" if cal is not None else "film table"
+    with np.errstate(all="ignore"):
+        axis = np.asarray(table.pressure_Pa, dtype=float)
+        if axis.size >= 2 and not np.all(np.diff(axis) > 0):
+            raise TableError(f"{where}: pressure axis is not strictly increasing (float64)")
+    problem = film_problem(table.pressure_Pa, table.hbar_m, table.slope_m_per_Pa, cal)
+    if problem is not None:
+        raise TableError(f"{where}: {problem}")
 
 
 def interpolate(table: FilmTable, pressure_Pa) -> np.ndarray:
@@ -74,6 +87,11 @@ def interpolate(table: FilmTable, pressure_Pa) -> np.ndarray:
 
 def max_relative_error(cal: Calibration, table: FilmTable) -> float:
     """Max |interpolated/exact - 1| on a grid DENSITY times denser than the table."""
+    with np.errstate(all="ignore"):
+        return _max_relative_error(cal, table)
+
+
+def _max_relative_error(cal: Calibration, table: FilmTable) -> float:
     p = table.pressure_Pa
     fractions = np.arange(DENSITY) / DENSITY
     grid = np.concatenate([(p[:-1, None] + fractions[None, :] * np.diff(p)[:, None]).ravel(), p[-1:]])
@@ -97,11 +115,24 @@ def c_float(x: float) -> str:
     return text + "f"
 
 
+_C_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
 def c_identifier(name: str) -> str:
-    ident = "".join(ch if ch.isalnum() else "_" for ch in name.lower())
-    if not ident or ident[0].isdigit():
-        raise TableError(f"calibration name {name!r} does not make a C identifier")
-    return ident
+    """The calibration's C name, lower case (wc_<name>_calibration, WC_<NAME>_FILM_NODES): name must be a
+    C identifier in ASCII (letters, digits, '_', not starting with a digit); nothing is mapped."""
+    if not _C_IDENTIFIER.fullmatch(name):
+        raise TableError(f"calibration name {name!r} is not a C identifier (ASCII letters, digits and '_', not"
+                         " starting with a digit): pass --name, or rename the calibration file")
+    return name.lower()
+
+
+def check_max_error(value: float) -> float:
+    """The --max-error bound: a finite number > 0 (NaN would disable the check)."""
+    if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            and value > 0):
+        raise TableError(f"--max-error {value!r}: must be a finite number > 0")
+    return float(value)
 
 
 def banner(command: str) -> str:
@@ -157,7 +188,8 @@ def calibration_header(cal: Calibration, ident: str, command: str) -> str:
 
 
 def generate(cal: Calibration, out_dir: Path, name: str, command: str) -> dict:
-    """Write both headers atomically (all or nothing); returns the figures."""
+    """Write both headers atomically (all or nothing); returns the figures. Every check (name, counts,
+    film rules) runs before anything is written."""
     ident = c_identifier(name)
     table = build_table(cal)
     error = max_relative_error(cal, table)
