@@ -26,6 +26,9 @@ bash scripts/bench_arm.sh
 echo "== package: find_package(wetclutch) after install, and add_subdirectory(), host and Cortex-M4F"
 bash scripts/check_package.sh
 
+echo "== libFuzzer harnesses (ASan + UBSan), 60 s each from the committed corpora (scripts/fuzz.sh)"
+bash scripts/fuzz.sh
+
 echo "== C unit tests (ctest)"
 ctest --test-dir build/host-debug --output-on-failure
 

@@ -1,0 +1,135 @@
+#!/usr/bin/env bash
+# libFuzzer harnesses with AddressSanitizer + UndefinedBehaviorSanitizer
+# (tests/fuzz, DESIGN.md section 8): builds them into build/fuzz with clang,
+# then runs each for a bounded time from a temporary copy of its committed
+# seed corpus (tests/fuzz/corpus/<name>, never modified).
+#
+#   bash scripts/fuzz.sh                      # model, loop, calibration: 60 s each
+#   FUZZ_SECONDS=600 bash scripts/fuzz.sh loop   # one (or several) by name, longer
+#
+# Environment:
+#   FUZZ_SECONDS   time per harness (libFuzzer -max_total_time), default 60
+#   FUZZ_RUNS      stop a harness after this many executions instead (-runs)
+#   FUZZ_FLAGS     extra libFuzzer flags, e.g. "-seed=1 -max_len=8192"
+#   WC_FUZZ_STRICT=1  fuzz_model also checks the arithmetic helpers outside
+#                     their documented domain (tests/fuzz/README.md)
+#
+# Prints per harness: executions, exec/s, coverage (cov: edges, ft: features),
+# corpus size, time. Exits non-zero when a harness crashes or an oracle is
+# violated, naming the reproducer (build/fuzz/artifacts/<name>/crash-...) and
+# the command that replays it. One fuzzer at a time, one process each
+# (no -jobs/-workers): the machine is shared.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+cd "$repo"
+
+all=(model loop calibration)
+harnesses=("$@")
+[ ${#harnesses[@]} -gt 0 ] || harnesses=("${all[@]}")
+for h in "${harnesses[@]}"; do
+  case " ${all[*]} " in
+    *" $h "*) ;;
+    *) echo "fuzz: unknown harness '$h' (one of: ${all[*]})" >&2; exit 2 ;;
+  esac
+done
+seconds=${FUZZ_SECONDS:-60}
+build=build/fuzz
+
+# --- toolchain: Debian's clang plus its compiler-rt (libFuzzer, ASan, UBSan)
+command -v clang >/dev/null || { echo "fuzz: clang not found (bash scripts/setup.sh installs it)" >&2; exit 1; }
+command -v cmake >/dev/null || { echo "fuzz: cmake not found (bash scripts/setup.sh installs it)" >&2; exit 1; }
+probe=$(mktemp -d)
+trap 'rm -rf "$probe"' EXIT
+printf '#include <stddef.h>\n#include <stdint.h>\nint LLVMFuzzerTestOneInput(const uint8_t *d, size_t n) { (void)d; (void)n; return 0; }\n' \
+  > "$probe/probe.c"
+if ! clang -fsanitize=fuzzer,address,undefined "$probe/probe.c" -o "$probe/probe" 2>"$probe/err"; then
+  major=$(clang -dumpversion | cut -d. -f1)
+  pkg="libclang-rt-${major}-dev"
+  # Debian ships libFuzzer and the sanitizer runtimes apart from clang.
+  if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null && apt-cache show "$pkg" >/dev/null 2>&1; then
+    echo "fuzz: clang's libFuzzer/sanitizer runtimes are missing: installing $pkg"
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$pkg" >/dev/null
+    clang -fsanitize=fuzzer,address,undefined "$probe/probe.c" -o "$probe/probe"
+  else
+    cat "$probe/err" >&2
+    echo "fuzz: clang cannot link a libFuzzer program: install $pkg (Debian) as root" >&2
+    exit 1
+  fi
+fi
+
+# --- build
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CMAKE_C_COMPILER:[A-Z]*=.*clang' "$build/CMakeCache.txt"; then
+  rm -rf "$build"  # configured with another compiler
+fi
+echo "== fuzz: build ($build)"
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  if ! CC=clang cmake -S tests/fuzz -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo >"$probe/cmake.log" 2>&1; then
+    cat "$probe/cmake.log" >&2
+    echo "fuzz: configuring tests/fuzz failed" >&2
+    exit 1
+  fi
+fi
+if ! cmake --build "$build" --parallel 2 >"$probe/build.log" 2>&1; then
+  cat "$probe/build.log" >&2
+  echo "fuzz: building the harnesses failed" >&2
+  exit 1
+fi
+
+# --- run
+work=$(mktemp -d)
+trap 'rm -rf "$probe" "$work"' EXIT
+mkdir -p "$build/logs"
+failed=0
+summary=()
+for h in "${harnesses[@]}"; do
+  exe="$build/fuzz_$h"
+  corpus="$work/corpus_$h"
+  artifacts="$build/artifacts/$h"
+  log="$build/logs/fuzz_$h.log"
+  mkdir -p "$corpus" "$artifacts"
+  cp tests/fuzz/corpus/"$h"/* "$corpus"/ 2>/dev/null || true
+  limit=(-max_total_time="$seconds")
+  bound="$seconds s"
+  if [ -n "${FUZZ_RUNS:-}" ]; then
+    limit=(-runs="$FUZZ_RUNS")
+    bound="$FUZZ_RUNS executions"
+  fi
+  max_len=4096
+  [ "$h" = loop ] && max_len=8192
+  echo "== fuzz: $h ($bound, seeds: tests/fuzz/corpus/$h, log: $log)"
+  start=$(date +%s)
+  set +e
+  # shellcheck disable=SC2086  # FUZZ_FLAGS is a list of flags
+  "$exe" "$corpus" "${limit[@]}" -max_len=$max_len -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$artifacts/" ${FUZZ_FLAGS:-} >"$log" 2>&1
+  rc=$?
+  set -e
+  elapsed=$(( $(date +%s) - start ))
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  covline=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1 || true)
+  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$covline")
+  ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$covline")
+  corp=$(sed -n 's/.* corp: \([^ ]*\).*/\1/p' <<<"$covline")
+  line=$(printf '%-12s executions %-10s exec/s %-7s cov %-5s ft %-6s corpus %-12s %4ss' "$h" "${execs:-?}" \
+    "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$elapsed")
+  if [ $rc -ne 0 ]; then
+    failed=1
+    repro=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
+    [ -n "$repro" ] || repro=$(ls -t "$artifacts"/* 2>/dev/null | head -1 || true)
+    echo "$line  FAILED (exit $rc)"
+    grep -E -A8 'ORACLE VIOLATION|WC_ASSERT FAILED|ERROR: AddressSanitizer|runtime error|ERROR: libFuzzer' "$log" | head -30 || true
+    echo "fuzz: $h FAILED: reproducer ${repro:-<none written; see $log>}"
+    [ -n "$repro" ] && echo "fuzz: replay with: $exe $repro"
+    summary+=("$line  FAILED: ${repro:-see $log}")
+  else
+    echo "$line  ok"
+    summary+=("$line  ok")
+  fi
+done
+
+echo "== fuzz: summary"
+printf '%s\n' "${summary[@]}"
+exit $failed

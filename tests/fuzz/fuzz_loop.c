@@ -1,0 +1,331 @@
+/* libFuzzer harness of the CAN frame loop (include/wetclutch_can/wc_loop.h)
+ * with the table1 calibration: a stream of CAN frames, timer ticks and port
+ * events into one wc_loop_t through wc_loop_iterate.
+ *
+ * Input:
+ *   byte 0  options: bit 0 clock (0 timer, 1 frame); bit 1 bench input
+ *           enabled; bit 2 "make valid": the harness writes the E2E CRC
+ *           (wc_e2e_protect) and an incrementing alive counter into every
+ *           ClutchSensors/TorqueRequest frame, so that the fuzzer gets past
+ *           E2E into the model; bit 3 "plausible": the signals of those
+ *           frames (and BenchMeasurement) are mapped into their DBC ranges
+ *           (the physical encoders write them); bits 4-5 start temperature
+ *           (40, -40, 250 degC or NaN); bit 6 a fuzzed loop configuration
+ *           (timeouts, E2E MaxDeltaCounter/SyncCounter, recovery) follows in
+ *           bytes 1-5, else WC_LOOP_CONFIG_DEFAULT.
+ *   then records until the bytes run out (at most MAX_RECORDS), each a
+ *   command byte c:
+ *     c & 3 == 0  a timer tick without a frame
+ *     c & 3 == 1  a frame; with the timer clock, a tick too if c bit 2
+ *     c & 3 == 2  a frame and a tick
+ *     c & 3 == 3  a port event (RX dropped / bus error / TX failed /
+ *                 deadline missed) with a count byte
+ *   c bits 3-5 choose the frame id (ClutchSensors x3, TorqueRequest x3,
+ *   BenchMeasurement, other); "other" reads a 16-bit id, and a byte of
+ *   format (bit 7 set: DLC = low nibble 0..15, flags = bits 4-6) follows
+ *   for every frame; then 8 data bytes (in plausible mode: 2 bytes per
+ *   signal). c bits 6-7 are the fault in "make valid" mode: 0 none, 1 alive
+ *   counter advanced by a fuzzed nibble (one more byte: 0 repeats, 2 loses a
+ *   frame, ...), 2 a wrong CRC (one more byte), 3 the frame as fuzzed.
+ *
+ * Oracle after every wc_loop_iterate (abort with a message on violation):
+ *  - it returns WC_LOOP_TX_FRAMES exactly when the clock says so (a tick, or
+ *    with the frame clock a ClutchSensors frame without flags), else 0;
+ *  - the step's frames: VfsCommand (0x120, DLC 8) decodes with a good CRC,
+ *    its alive counter counts +1, reserved status bits are 0; VfsCurrent
+ *    within the calibration's current range, and the model's own output
+ *    (loop->last) finite and in range (a NaN current would be sent as 0 mA);
+ *    ClutchEstimate (0x121) decodes without SNA or range error;
+ *  - safe state: a timeout bit implies StatusSafeStateActive; the safe state
+ *    ends only after both inputs were fresh for recovery_periods steps in a
+ *    row; in the safe state the current is the calibration's minimum;
+ *    StatusBenchInput only with bench input enabled;
+ *  - counters: frames_used + sum(rejected) + frames still queued ==
+ *    frames_in; frames_out == 2 steps.
+ * At the end one more tick empties the ring and the counters must add up
+ * with nothing queued. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <wetclutch/wetclutch.h>
+#include <wetclutch_can/wc_e2e.h>
+#include <wetclutch_can/wc_loop.h>
+
+#include "wc_fuzz_common.h"
+#include "wc_table1_calibration.h"
+
+#define MAX_RECORDS 4096u
+
+static const wc_calibration_t *const cal = &wc_table1_calibration;
+static bool verbose;
+
+int LLVMFuzzerInitialize(int *argc, char ***argv);
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerInitialize(int *argc, char ***argv)
+{
+    (void)argc;
+    (void)argv;
+    verbose = fz_env_flag("WC_FUZZ_VERBOSE");
+    return 0;
+}
+
+typedef struct {
+    wc_loop_clock_t clock;
+    bool make_valid;
+    bool plausible;
+    wc_loop_config_t config;
+    uint8_t alive_sensors;   /* next alive counter of each E2E frame ("make valid") */
+    uint8_t alive_request;
+    bool have_tx;            /* a VfsCommand was seen: its counter must count */
+    uint8_t tx_alive;
+    uint32_t fresh_run;      /* consecutive steps without a timeout bit */
+    uint32_t steps;
+    uint32_t safe_steps;     /* statistics for WC_FUZZ_VERBOSE */
+    uint32_t control_steps;
+} harness_t;
+
+static wc_loop_t loop;  /* ~1 KiB: static, not on the fuzzer's stack */
+
+static float map_u16(uint16_t u, float lo, float hi) { return lo + (hi - lo) * ((float)u / 65535.0f); }
+
+/* A frame as the fuzzer describes it (see the top of the file). */
+static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t *f)
+{
+    static const uint32_t ids[7] = {
+        WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_CLUTCH_SENSORS_FRAME_ID,
+        WC_CAN_TORQUE_REQUEST_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID,
+        WC_CAN_BENCH_MEASUREMENT_FRAME_ID,
+    };
+    const uint8_t sel = (uint8_t)((c >> 3) & 7u);
+    memset(f, 0, sizeof *f);
+    f->id = (sel < 7u) ? ids[sel] : (uint32_t)fz_u16(r);
+    const uint8_t format = fz_u8(r);
+    if ((format & 0x80u) != 0u) {
+        f->dlc = (uint8_t)(format & 0x0Fu);
+        f->flags = (uint8_t)((format >> 4) & 0x07u);
+        if ((f->flags & WC_CAN_FLAG_EXTENDED) != 0u) { f->id = (f->id << 13) ^ fz_u16(r); }  /* 29-bit ids */
+    } else {
+        f->dlc = 8u;
+        f->flags = 0u;
+    }
+    const uint8_t fault = h->make_valid ? (uint8_t)(c >> 6) : 3u;
+    const bool sensors = (f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID);
+    const bool request = (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID);
+    const bool bench = (f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
+    if (h->plausible && (fault != 3u) && (sensors || request || bench)) {
+        if (sensors) {
+            const wc_can_clutch_sensors_phys_t s = {
+                map_u16(fz_u16(r), -8000.0f, 8000.0f), map_u16(fz_u16(r), -40.0f, 200.0f),
+                map_u16(fz_u16(r), -40.0f, 200.0f), 0u };
+            (void)wc_can_encode_clutch_sensors(f->data, &s, sizeof f->data);
+        } else if (request) {
+            const wc_can_torque_request_phys_t q = { map_u16(fz_u16(r), 0.0f, 2000.0f), (uint8_t)(fz_u8(r) % 3u), 0u };
+            (void)wc_can_encode_torque_request(f->data, &q, sizeof f->data);
+        } else {
+            const wc_can_bench_measurement_phys_t b = {
+                map_u16(fz_u16(r), -20000.0f, 20000.0f), map_u16(fz_u16(r), -5000.0f, 5000.0f),
+                map_u16(fz_u16(r), -40.0f, 350.0f) };
+            (void)wc_can_encode_bench_measurement(f->data, &b, sizeof f->data);
+        }
+    } else {
+        for (size_t i = 0u; i < sizeof f->data; ++i) { f->data[i] = fz_u8(r); }
+    }
+    if (!h->make_valid || !(sensors || request) || (fault == 3u)) { return; }
+    uint8_t *alive = sensors ? &h->alive_sensors : &h->alive_request;
+    if (fault == 1u) {  /* counter = previous + delta: 0 repeats, 2 loses one frame, ... */
+        const uint8_t delta = (uint8_t)(fz_u8(r) & WC_E2E_COUNTER_MASK);
+        *alive = (uint8_t)((*alive + delta + 15u) % 16u);
+    }
+    f->data[WC_E2E_COUNTER_BYTE] = (uint8_t)((f->data[WC_E2E_COUNTER_BYTE] & ~WC_E2E_COUNTER_MASK) | *alive);
+    *alive = wc_e2e_counter_next(*alive);
+    (void)wc_e2e_protect(f->id, f->data, sizeof f->data);
+    if (fault == 2u) { f->data[WC_E2E_CRC_BYTE] ^= (uint8_t)(fz_u8(r) | 1u); }  /* a wrong CRC */
+}
+
+static uint32_t rejected_sum(const wc_loop_t *l)
+{
+    uint32_t n = 0u;
+    for (unsigned i = 0u; i < (unsigned)WC_REJECT_REASONS; ++i) { n += l->counters.rejected[i]; }
+    return n;
+}
+
+static void check_counters(const harness_t *h)
+{
+    const uint32_t queued = loop.rx_tail - loop.rx_head;
+    FZ_CHECK(queued <= WC_LOOP_RX_CAPACITY, "ring holds %u frames", (unsigned)queued);
+    FZ_CHECK(loop.counters.frames_used + rejected_sum(&loop) + queued == loop.counters.frames_in,
+             "counters: used %u + rejected %u + queued %u != in %u", (unsigned)loop.counters.frames_used,
+             (unsigned)rejected_sum(&loop), (unsigned)queued, (unsigned)loop.counters.frames_in);
+    FZ_CHECK((loop.counters.steps == h->steps) && (loop.counters.frames_out == 2u * h->steps),
+             "steps %u (harness %u), frames out %u", (unsigned)loop.counters.steps, (unsigned)h->steps,
+             (unsigned)loop.counters.frames_out);
+}
+
+/* The frames and state after a step. */
+static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    h->steps++;
+    const float i_min = cal->vfs_current_min_mA;
+    const float i_max = cal->vfs_current_max_mA;
+    const float lsb_mA = 1.0f / 32.0f;  /* VfsCurrent scaling */
+
+    /* the model's own output (the frame would hide a NaN as 0 mA) */
+    const wc_step_output_t *o = &loop.last;
+    FZ_CHECK(fz_finite(o->current_mA) && (o->current_mA >= i_min) && (o->current_mA <= i_max),
+             "model current %g outside [%g, %g]", (double)o->current_mA, (double)i_min, (double)i_max);
+    FZ_CHECK(fz_finite(o->pressure_command_Pa) && fz_finite(o->pressure_model_Pa) && fz_finite(o->force_command_N) &&
+                 fz_finite(o->theta_degC) && fz_finite(o->model.torque_Nm) && fz_finite(o->model.hbar_m) &&
+                 fz_finite(o->model.mu_f) && (o->model.hbar_m > 0.0f),
+             "non-finite step output: P %g Pm %g F %g theta %g T %g hbar %g mu_f %g", (double)o->pressure_command_Pa,
+             (double)o->pressure_model_Pa, (double)o->force_command_N, (double)o->theta_degC,
+             (double)o->model.torque_Nm, (double)o->model.hbar_m, (double)o->model.mu_f);
+    FZ_CHECK((loop.clutch.theta_degC >= WC_THETA_MIN_degC) && (loop.clutch.theta_degC <= WC_THETA_MAX_degC),
+             "estimate %g outside the envelope", (double)loop.clutch.theta_degC);
+    FZ_CHECK((o->status & WC_STATUS_NOT_INITIALISED) == 0u, "model status 0x%x", (unsigned)o->status);
+
+    /* VfsCommand */
+    FZ_CHECK((out[0].id == WC_CAN_VFS_COMMAND_FRAME_ID) && (out[0].dlc == 8u) && (out[0].flags == 0u),
+             "first frame id 0x%x dlc %u flags %u", (unsigned)out[0].id, (unsigned)out[0].dlc, (unsigned)out[0].flags);
+    wc_can_vfs_command_phys_t cmd;
+    const wc_can_result_t rc = wc_can_decode_vfs_command(&cmd, out[0].data, out[0].dlc);
+    FZ_CHECK(!wc_can_is_error(rc), "VfsCommand does not decode: result %d", (int)rc);
+    FZ_CHECK((out[0].data[7] & 0xC0u) == 0u, "reserved status bits set: byte 7 = 0x%02x", (unsigned)out[0].data[7]);
+    if (h->have_tx) {
+        FZ_CHECK(cmd.alive_counter == (uint8_t)((h->tx_alive + 1u) % 16u), "tx alive counter %u after %u",
+                 (unsigned)cmd.alive_counter, (unsigned)h->tx_alive);
+    }
+    h->have_tx = true;
+    h->tx_alive = cmd.alive_counter;
+    FZ_CHECK((cmd.vfs_current_mA >= i_min - 0.5f * lsb_mA) && (cmd.vfs_current_mA <= i_max + 0.5f * lsb_mA),
+             "VfsCurrent %g outside [%g, %g]", (double)cmd.vfs_current_mA, (double)i_min, (double)i_max);
+    FZ_CHECK(fabsf(cmd.vfs_current_mA - o->current_mA) <= 0.5f * lsb_mA, "VfsCurrent %g, model current %g",
+             (double)cmd.vfs_current_mA, (double)o->current_mA);
+
+    /* safe state and its debounce */
+    const uint16_t timeouts = WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT;
+    const bool safe = (cmd.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) != 0u;
+    h->fresh_run = ((cmd.status & timeouts) != 0u) ? 0u : h->fresh_run + 1u;
+    if ((cmd.status & timeouts) != 0u) {
+        FZ_CHECK(safe, "timeout bits 0x%x without StatusSafeStateActive", (unsigned)cmd.status);
+    }
+    if (!safe) {
+        FZ_CHECK(h->fresh_run >= h->config.recovery_periods,
+                 "safe state left after %u fresh steps (recovery %u)", (unsigned)h->fresh_run,
+                 (unsigned)h->config.recovery_periods);
+        h->control_steps++;
+    } else {
+        FZ_CHECK((o->current_mA == i_min) && (fabsf(cmd.vfs_current_mA - i_min) <= 0.5f * lsb_mA),
+                 "safe state with current %g mA (frame %g), minimum %g", (double)o->current_mA,
+                 (double)cmd.vfs_current_mA, (double)i_min);
+        h->safe_steps++;
+    }
+    if (!h->config.bench_input_enabled) {
+        FZ_CHECK((cmd.status & WC_CAN_STATUS_BENCH_INPUT) == 0u, "StatusBenchInput with bench input off");
+    }
+
+    /* ClutchEstimate */
+    FZ_CHECK((out[1].id == WC_CAN_CLUTCH_ESTIMATE_FRAME_ID) && (out[1].dlc == 8u) && (out[1].flags == 0u),
+             "second frame id 0x%x dlc %u flags %u", (unsigned)out[1].id, (unsigned)out[1].dlc, (unsigned)out[1].flags);
+    wc_can_clutch_estimate_phys_t est;
+    const wc_can_result_t re = wc_can_decode_clutch_estimate(&est, out[1].data, out[1].dlc);
+    FZ_CHECK(!wc_can_is_error(re), "ClutchEstimate does not decode cleanly (result %d: SNA = NaN sent, or range)",
+             (int)re);
+    check_counters(h);
+}
+
+static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsigned record)
+{
+    wc_can_frame_t out[WC_LOOP_TX_FRAMES];
+    memset(out, 0, sizeof out);
+    fz_context(frame ? "wc_loop_iterate(frame)" : "wc_loop_iterate(NULL, tick)", record);
+    if (frame != NULL) {
+        fz_ctx.iargs[0] = (long)frame->id;
+        fz_ctx.iargs[1] = (long)frame->dlc * 16 + frame->flags;
+    }
+    const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
+    const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
+                                   (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
+    FZ_CHECK(n == (expected ? WC_LOOP_TX_FRAMES : 0u), "wc_loop_iterate returned %u, expected %u", (unsigned)n,
+             expected ? (unsigned)WC_LOOP_TX_FRAMES : 0u);
+    if (n == WC_LOOP_TX_FRAMES) {
+        check_step(h, out);
+    } else {
+        check_counters(h);
+    }
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_reader_t r;
+    fz_reader_init(&r, data, size);
+    harness_t h;
+    memset(&h, 0, sizeof h);
+    const uint8_t options = fz_u8(&r);
+    h.clock = ((options & 0x01u) != 0u) ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
+    h.make_valid = (options & 0x04u) != 0u;
+    h.plausible = (options & 0x08u) != 0u;
+    static const float starts[4] = { 40.0f, -40.0f, 250.0f, NAN };
+    const float theta_start = starts[(options >> 4) & 3u];
+    const wc_loop_config_t defaults = WC_LOOP_CONFIG_DEFAULT;
+    h.config = defaults;
+    if ((options & 0x40u) != 0u) {
+        h.config.sensor_timeout_periods = fz_u8(&r) % 32u;
+        h.config.request_timeout_periods = fz_u8(&r) % 32u;
+        h.config.e2e.max_delta_counter = fz_u8(&r) % 20u;
+        h.config.e2e.sync_counter = fz_u8(&r) % 8u;
+        h.config.recovery_periods = fz_u8(&r) % 64u;
+    }
+    h.config.bench_input_enabled = (options & 0x02u) != 0u;
+
+    fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
+    fz_arg(theta_start);
+    fz_ctx.iargs[0] = options;
+    fz_ctx.iargs[1] = (long)h.config.recovery_periods;
+    FZ_CHECK(wc_loop_init(&loop, cal, &h.config, theta_start) == WC_CAL_OK, "wc_loop_init failed");
+
+    for (unsigned record = 1u; (record <= MAX_RECORDS) && fz_more(&r); ++record) {
+        const uint8_t c = fz_u8(&r);
+        switch (c & 3u) {
+        case 0:
+            iterate(&h, NULL, true, record);
+            break;
+        case 1:
+        case 2: {
+            wc_can_frame_t f;
+            build_frame(&h, &r, c, &f);
+            const bool tick = ((c & 3u) == 2u) || ((h.clock == WC_LOOP_CLOCK_TIMER) && ((c & 0x04u) != 0u));
+            iterate(&h, &f, tick, record);
+            break;
+        }
+        default: {
+            const uint8_t count = fz_u8(&r);
+            fz_context("port event", record);
+            switch ((c >> 2) & 3u) {
+            case 0: wc_loop_port_event(&loop, WC_LOOP_PORT_RX_DROPPED, count); break;
+            case 1: wc_loop_port_event(&loop, WC_LOOP_PORT_BUS_ERROR, count); break;
+            case 2: wc_loop_port_event(&loop, WC_LOOP_PORT_TX_FAILED, count); break;
+            default: wc_loop_deadline_missed(&loop, count); break;
+            }
+            check_counters(&h);
+            break;
+        }
+        }
+    }
+    iterate(&h, NULL, true, MAX_RECORDS + 1u);  /* empties the ring */
+    FZ_CHECK(loop.rx_tail == loop.rx_head, "frames left in the ring after a step");
+    if (verbose) {
+        fprintf(stderr,
+                "fuzz_loop: %zu bytes, clock %d, valid %d, plausible %d: steps %u (control %u, safe %u), frames in %u, "
+                "used %u, rejected crc %u counter %u short %u unknown %u format %u implausible %u overflow %u sync %u\n",
+                size, (int)h.clock, (int)h.make_valid, (int)h.plausible, (unsigned)h.steps, (unsigned)h.control_steps,
+                (unsigned)h.safe_steps, (unsigned)loop.counters.frames_in, (unsigned)loop.counters.frames_used,
+                (unsigned)loop.counters.rejected[WC_REJECT_CRC], (unsigned)loop.counters.rejected[WC_REJECT_COUNTER],
+                (unsigned)loop.counters.rejected[WC_REJECT_SHORT], (unsigned)loop.counters.rejected[WC_REJECT_UNKNOWN_ID],
+                (unsigned)loop.counters.rejected[WC_REJECT_FORMAT],
+                (unsigned)loop.counters.rejected[WC_REJECT_IMPLAUSIBLE],
+                (unsigned)loop.counters.rejected[WC_REJECT_OVERFLOW], (unsigned)loop.counters.rejected[WC_REJECT_SYNC]);
+    }
+    return 0;
+}

@@ -1,0 +1,316 @@
+#!/usr/bin/env python3
+"""Write the hand-made seed corpora of the libFuzzer harnesses.
+
+    python3 tests/fuzz/make_seeds.py            # rewrites tests/fuzz/corpus/{model,loop,calibration}/
+
+Standard library only, deterministic (the committed seeds are its output).
+The byte formats are described at the top of each harness (fuzz_model.c,
+fuzz_loop.c, fuzz_calibration.c); the CAN frames follow hil/wetclutch.dbc
+(little-endian signals, CRC-8 SAE J1850 over the data id and bytes 1..7,
+alive counter in the low nibble of byte 1: src/can/wc_e2e.h).
+"""
+import math
+import pathlib
+import struct
+
+HERE = pathlib.Path(__file__).resolve().parent
+CORPUS = HERE / "corpus"
+
+
+# --------------------------------------------------------------------------
+# shared: fz_float encodings (wc_fuzz_common.h)
+# --------------------------------------------------------------------------
+
+def f_raw(x):
+    """tag 0: the float's raw bit pattern, whatever the argument's range."""
+    return bytes([0]) + struct.pack("<f", x)
+
+
+def f_bits(bits):
+    return bytes([0]) + struct.pack("<I", bits)
+
+
+# --------------------------------------------------------------------------
+# model harness
+# --------------------------------------------------------------------------
+
+OP_TORQUE, OP_INVERSE, OP_THERMAL, OP_FRICTION, OP_VISCOSITY, OP_FILM, OP_HYDRAULICS, OP_STEP = range(8)
+MODE_OPEN, MODE_TORQUE, MODE_LOCKED = 0, 1, 2
+NAN_BITS, INF_BITS, NINF_BITS, DENORMAL_BITS = 0x7FC00000, 0x7F800000, 0xFF800000, 0x00000001
+
+
+def step(slip, oil, housing, request, mode, bench=None):
+    flags = 0x02 if bench else 0x00
+    out = bytes([OP_STEP, flags]) + slip + oil + housing + request + bytes([mode])
+    if bench:
+        out += bench[0] + bench[1]
+    return out
+
+
+def model_seeds():
+    seeds = {}
+    # a normal engagement: open, torque ramp while the slip falls, locked
+    b = f_raw(60.0)
+    for k in range(8):
+        b += step(f_raw(150.0), f_raw(60.0), f_raw(55.0), f_raw(0.0), MODE_OPEN)
+    for k in range(24):
+        b += step(f_raw(150.0 * (1 - k / 24)), f_raw(60.0), f_raw(55.0), f_raw(8.0 * k), MODE_TORQUE)
+    for k in range(4):
+        b += step(f_raw(0.0), f_raw(60.0), f_raw(55.0), f_raw(200.0), MODE_LOCKED)
+    seeds["engagement"] = b
+    # every public function once at a nominal point (DESIGN.md section 2 references)
+    b = f_raw(40.0)
+    b += bytes([OP_TORQUE]) + f_raw(78.54) + f_raw(65.0) + f_raw(1188.0)
+    b += bytes([OP_INVERSE]) + f_raw(78.54) + f_raw(90.0) + f_raw(150.0)
+    b += bytes([OP_THERMAL, 0x00]) + f_raw(50.0) + f_raw(1000.0) + f_raw(40.0) + f_raw(30.0)
+    b += bytes([OP_FRICTION]) + f_raw(0.5) + f_raw(90.0)
+    b += bytes([OP_VISCOSITY]) + f_raw(65.0)
+    b += bytes([OP_FILM]) + f_raw(293117.0) + f_raw(398038.0)
+    b += bytes([OP_HYDRAULICS, 0]) + f_raw(1214.8)
+    b += bytes([OP_HYDRAULICS, 1]) + f_raw(363000.0)
+    b += bytes([OP_HYDRAULICS, 2]) + f_raw(363000.0)
+    b += bytes([OP_HYDRAULICS, 3]) + f_raw(0.0) + f_raw(157.8)
+    seeds["every_function"] = b
+    # bad numbers: NaN, +-Inf, denormals, out of range; unknown modes
+    b = f_bits(NAN_BITS)
+    b += step(f_bits(NAN_BITS), f_bits(INF_BITS), f_bits(NINF_BITS), f_bits(NAN_BITS), MODE_TORQUE)
+    b += step(f_raw(2000.0), f_raw(-50.0), f_raw(300.0), f_raw(-1.0), 240)  # mode 3
+    b += step(f_bits(DENORMAL_BITS), f_raw(20.0), f_raw(20.0), f_raw(1e6), 244)  # mode -1
+    b += bytes([OP_TORQUE]) + f_bits(NAN_BITS) + f_bits(INF_BITS) + f_raw(-1.0)
+    b += bytes([OP_INVERSE]) + f_raw(1047.2) + f_raw(250.0) + f_raw(1e5)
+    b += bytes([OP_FILM]) + f_bits(NAN_BITS) + f_raw(-1.0)
+    b += bytes([OP_HYDRAULICS, 2]) + f_bits(NAN_BITS)
+    seeds["bad_numbers"] = b
+    # a hot clutch: locked at high slip until the over-temperature bit, then cooling
+    b = f_raw(180.0)
+    for k in range(12):
+        b += step(f_raw(1000.0), f_raw(150.0), f_raw(150.0), f_raw(0.0), MODE_LOCKED)
+    for k in range(4):
+        b += step(f_raw(0.0), f_raw(20.0), f_raw(20.0), f_raw(0.0), MODE_OPEN)
+    seeds["hot_clutch"] = b
+    # on a bench: load cell and torque sensor, once implausible
+    b = f_raw(40.0)
+    for k in range(6):
+        b += step(f_raw(-80.0), f_raw(70.0), f_raw(60.0), f_raw(100.0), MODE_TORQUE,
+                  bench=(f_raw(900.0 + 50 * k), f_raw(-120.0)))
+    b += step(f_raw(-80.0), f_raw(70.0), f_raw(60.0), f_raw(100.0), MODE_TORQUE,
+              bench=(f_raw(-5.0), f_bits(NAN_BITS)))
+    seeds["bench"] = b
+    return seeds
+
+
+# --------------------------------------------------------------------------
+# loop harness
+# --------------------------------------------------------------------------
+
+ID_SENSORS, ID_REQUEST, ID_BENCH = 0x110, 0x111, 0x130
+SEL_SENSORS, SEL_REQUEST, SEL_BENCH, SEL_OTHER = 0, 3, 6, 7
+
+
+def crc8_j1850(data):
+    crc = 0xFF
+    for byte in data:
+        crc ^= byte
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc ^ 0xFF
+
+
+assert crc8_j1850(b"123456789") == 0x4B
+
+
+def pack(fields):
+    """fields: (start bit, length, raw value); little-endian (Intel) signals."""
+    word = 0
+    for start, length, raw in fields:
+        word |= (raw & ((1 << length) - 1)) << start
+    return bytearray(word.to_bytes(8, "little"))
+
+
+def protect(frame_id, data):
+    data[0] = crc8_j1850(bytes([frame_id & 0xFF]) + bytes(data[1:8]))
+    return bytes(data)
+
+
+def sensors_frame(alive, slip_rpm, oil_degC, housing_degC):
+    data = pack([(8, 4, alive), (16, 16, round(slip_rpm / 0.25)),
+                 (32, 12, round((oil_degC + 50) / 0.1)), (44, 12, round((housing_degC + 50) / 0.1))])
+    return protect(ID_SENSORS, data)
+
+
+def request_frame(alive, torque_Nm, mode):
+    data = pack([(8, 4, alive), (12, 4, mode), (16, 16, round(torque_Nm / 0.05))])
+    return protect(ID_REQUEST, data)
+
+
+def bench_frame(force_N, torque_Nm, temp_degC):
+    return bytes(pack([(0, 20, round(force_N / 0.1)), (20, 20, round(torque_Nm / 0.01)),
+                       (40, 12, round((temp_degC + 50) / 0.1))]))
+
+
+def rec_frame(sel, data, tick=False, kind=1, fault=0, fmt=0x00, other_id=None, ext_bits=None):
+    """One record of fuzz_loop.c: command byte, [16-bit id for SEL_OTHER],
+    format byte, [16 more id bits for an extended frame], data."""
+    c = kind | (0x04 if tick else 0) | (sel << 3) | (fault << 6)
+    out = bytes([c])
+    if sel == SEL_OTHER:
+        out += struct.pack("<H", other_id)
+    out += bytes([fmt])
+    if fmt & 0x80 and (fmt >> 4) & 0x01:
+        out += struct.pack("<H", ext_bits or 0)
+    return out + data
+
+
+def engagement_profile(periods=80):
+    """(slip rpm, oil, housing, request Nm, mode) per 1 ms period."""
+    out = []
+    for k in range(periods):
+        if k < 30:
+            out.append((1500.0, 80.0, 75.0, 0.0, MODE_OPEN))
+        elif k < 70:
+            u = (k - 30) / 40
+            out.append((1500.0 * (1 - u), 80.0, 75.0, 150.0 * u, MODE_TORQUE))
+        else:
+            out.append((0.0, 80.0, 75.0, 200.0, MODE_LOCKED))
+    return out
+
+
+def loop_engagement(clock_frame, bench=False):
+    options = (0x01 if clock_frame else 0x00) | (0x02 if bench else 0x00)
+    b = bytes([options])
+    for k, (slip, oil, housing, req, mode) in enumerate(engagement_profile()):
+        alive = k % 16
+        if bench:
+            b += rec_frame(SEL_BENCH, bench_frame(800.0 + 5 * k, 120.0, 85.0))
+        if clock_frame:  # the request first: the ClutchSensors frame ends the period
+            b += rec_frame(SEL_REQUEST, request_frame(alive, req, mode))
+            b += rec_frame(SEL_SENSORS, sensors_frame(alive, slip, oil, housing))
+        else:
+            b += rec_frame(SEL_SENSORS, sensors_frame(alive, slip, oil, housing))
+            b += rec_frame(SEL_REQUEST, request_frame(alive, req, mode), tick=True)
+    return b
+
+
+def u16_of(x, lo, hi):
+    return struct.pack("<H", max(0, min(65535, round((x - lo) / (hi - lo) * 65535))))
+
+
+def loop_plausible():
+    """'make valid' + 'plausible': the harness writes CRC and counters."""
+    b = bytes([0x04 | 0x08])
+    for slip, oil, housing, req, mode in engagement_profile():
+        b += bytes([1 | (SEL_SENSORS << 3), 0x00]) + u16_of(slip, -8000, 8000) + u16_of(oil, -40, 200) + \
+            u16_of(housing, -40, 200)
+        b += bytes([1 | 0x04 | (SEL_REQUEST << 3), 0x00]) + u16_of(req, 0, 2000) + bytes([mode])
+    return b
+
+
+def loop_faults():
+    """A good start, then one of each fault of the README's matrix, then silence."""
+    b = bytes([0x04])  # make valid, raw signals
+    good_s = sensors_frame(0, 800.0, 60.0, 60.0)
+    good_q = request_frame(0, 50.0, MODE_TORQUE)
+    for k in range(26):
+        b += rec_frame(SEL_SENSORS, good_s)
+        b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    b += rec_frame(SEL_SENSORS, good_s, fault=2) + bytes([0x5A])          # CRC error
+    b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    b += rec_frame(SEL_SENSORS, good_s, fault=1) + bytes([0])             # repeated counter
+    b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    b += rec_frame(SEL_SENSORS, good_s, fault=1) + bytes([5])             # counter jump
+    b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    b += rec_frame(SEL_SENSORS, sensors_frame(0, 0, 4095 * 0.1 - 50, 60.0))  # OilTemp SNA
+    b += rec_frame(SEL_REQUEST, request_frame(0, 50.0, 7), tick=True)      # reserved Mode
+    b += rec_frame(SEL_SENSORS, good_s, fmt=0x84)                         # DLC 4
+    b += rec_frame(SEL_OTHER, bytes(8), other_id=0x7FF)                     # unknown id
+    b += rec_frame(SEL_REQUEST, good_q, fmt=0x98, tick=True, ext_bits=0x111)  # extended flag, DLC 8
+    b += bytes([3 | (0 << 2), 3]) + bytes([3 | (1 << 2), 1]) + bytes([3 | (3 << 2), 2])  # port events
+    for k in range(14):
+        b += bytes([0])                                                   # ticks only: timeouts
+    for k in range(30):
+        b += rec_frame(SEL_SENSORS, good_s)
+        b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    return b
+
+
+def loop_overflow():
+    """40 frames between two steps: the ring (32) overflows."""
+    b = bytes([0x04])
+    for k in range(40):
+        b += rec_frame(SEL_SENSORS, sensors_frame(0, 100.0, 40.0, 40.0))
+    b += bytes([0])
+    return b
+
+
+def loop_seeds():
+    return {
+        "engagement_timer": loop_engagement(False),
+        "engagement_frame_clock": loop_engagement(True),
+        "engagement_bench": loop_engagement(False, bench=True),
+        "engagement_plausible": loop_plausible(),
+        "faults": loop_faults(),
+        "overflow": loop_overflow(),
+    }
+
+
+# --------------------------------------------------------------------------
+# calibration harness
+# --------------------------------------------------------------------------
+
+FLOAT_FIELDS = [
+    "outer_radius_m", "inner_radius_m", "friction_area_m2", "piston_area_m2", "oil_conductance_W_per_K",
+    "housing_conductance_W_per_K", "heat_capacity_J_per_K", "viscosity_a1_Pa_s", "viscosity_b1_per_K",
+    "viscosity_a2_Pa_s", "viscosity_b2_per_K", "mu1", "mu2", "mu3", "stribeck_speed_m_s", "theta1_degC",
+    "theta2_K", "vfs_gain_Pa_per_mA", "vfs_time_constant_s", "return_spring_force_N", "vfs_current_min_mA",
+    "vfs_current_max_mA", "control_period_s",
+]
+
+
+def set_field(name, value):
+    """target byte, mutation 0 (fz_float), tag 0 (raw bits)."""
+    return bytes([FLOAT_FIELDS.index(name), 0]) + f_raw(value)
+
+
+def scale_field(name, eighths):
+    """mutation 1: times 2^(eighths / 8)."""
+    return bytes([FLOAT_FIELDS.index(name), 1, eighths & 0xFF])
+
+
+def calibration_seeds():
+    bench = {  # lut/wc_bench_identified_calibration.h, scalar fields
+        "oil_conductance_W_per_K": 117.4738, "housing_conductance_W_per_K": 41.49914,
+        "viscosity_a1_Pa_s": 0.1542595, "viscosity_b1_per_K": -0.08156193, "viscosity_a2_Pa_s": 0.06148355,
+        "viscosity_b2_per_K": -0.02216161, "mu1": 0.1199572, "mu2": 0.09270761, "mu3": 0.4985932,
+        "stribeck_speed_m_s": 0.02549717,
+    }
+    return {
+        "table1": bytes([0]),
+        "film_copy_64": bytes([1, 64, 0]),
+        "film_even_16": bytes([1, 16, 0]),
+        "film_last_8": bytes([5, 8, 56]),  # the 8 stiffest nodes: the open clutch at a thin film
+        "bench_identified": bytes([0]) + b"".join(set_field(k, v) for k, v in bench.items()),
+        # a 2 A solenoid at half the gain (the same pressure range), 10 ms period
+        "solenoid_2A_10ms": bytes([0]) + set_field("vfs_current_max_mA", 2000.0) + set_field("vfs_current_min_mA", 50.0)
+        + set_field("vfs_gain_Pa_per_mA", 1150.0) + set_field("control_period_s", 0.01)
+        + set_field("vfs_time_constant_s", 0.02),
+        # radii / 2, areas / 4, 4 friction pairs, 32 film nodes
+        "small_clutch": bytes([1, 32, 0]) + scale_field("outer_radius_m", -8) + scale_field("inner_radius_m", -8)
+        + scale_field("friction_area_m2", -16) + scale_field("piston_area_m2", -16)
+        + bytes([len(FLOAT_FIELDS), 0, 4]),
+        "hot_oil_map": bytes([0]) + set_field("mu3", 0.2) + set_field("theta1_degC", 90.0)
+        + set_field("viscosity_b1_per_K", -0.05),
+    }
+
+
+def main():
+    for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration_seeds())):
+        folder = CORPUS / name
+        folder.mkdir(parents=True, exist_ok=True)
+        for seed, data in sorted(seeds.items()):
+            (folder / seed).write_bytes(data)
+        print(f"{folder.relative_to(HERE.parent.parent)}: {len(seeds)} seeds, "
+              f"{sum(len(d) for d in seeds.values())} bytes")
+
+
+if __name__ == "__main__":
+    main()
