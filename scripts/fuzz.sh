@@ -98,6 +98,19 @@ for h in "${harnesses[@]}"; do
   fi
   max_len=4096
   [ "$h" = loop ] && max_len=8192
+  # Regression first: the recorded findings (tests/fuzz/findings/<name>-*) must pass.
+  findings=(tests/fuzz/findings/"$h"-*)
+  if [ -e "${findings[0]}" ]; then
+    if ! "$exe" "${findings[@]}" >"$build/logs/fuzz_${h}_findings.log" 2>&1; then
+      failed=1
+      grep -E -B2 -A6 'ORACLE VIOLATION|WC_ASSERT FAILED|ERROR: AddressSanitizer|runtime error' \
+        "$build/logs/fuzz_${h}_findings.log" | head -30 || true
+      echo "fuzz: $h FAILED on a recorded finding (tests/fuzz/findings/README.md); log: $build/logs/fuzz_${h}_findings.log"
+      summary+=("$(printf '%-12s' "$h") FAILED: a recorded finding fails again (tests/fuzz/findings)")
+      continue
+    fi
+    echo "== fuzz: $h: ${#findings[@]} recorded findings replayed, ok"
+  fi
   echo "== fuzz: $h ($bound, seeds: tests/fuzz/corpus/$h, log: $log)"
   start=$(date +%s)
   set +e
@@ -115,6 +128,9 @@ for h in "${harnesses[@]}"; do
   corp=$(sed -n 's/.* corp: \([^ ]*\).*/\1/p' <<<"$covline")
   line=$(printf '%-12s executions %-10s exec/s %-7s cov %-5s ft %-6s corpus %-12s %4ss' "$h" "${execs:-?}" \
     "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$elapsed")
+  # a harness's own summary at exit (fuzz_calibration: how many calibrations were accepted)
+  own=$(grep -E "^fuzz_$h: [0-9]+ inputs" "$log" | tail -1 || true)
+  [ -n "$own" ] && echo "   $own"
   if [ $rc -ne 0 ]; then
     failed=1
     repro=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
