@@ -11,8 +11,8 @@
 #   FUZZ_SECONDS   time per harness (libFuzzer -max_total_time), default 60
 #   FUZZ_RUNS      stop a harness after this many executions instead (-runs)
 #   FUZZ_FLAGS     extra libFuzzer flags, e.g. "-seed=1 -max_len=8192"
-#   WC_FUZZ_STRICT=1  fuzz_model also checks the arithmetic helpers outside
-#                     their documented domain (tests/fuzz/README.md)
+#   WC_FUZZ_LAX=1  fuzz_model checks the arithmetic helpers only inside the
+#                  domain the library calls them with (default: every input)
 #
 # Prints per harness: executions, exec/s, coverage (cov: edges, ft: features),
 # corpus size, time. Exits non-zero when a harness crashes or an oracle is

@@ -74,7 +74,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         if (in->mode != WC_MODE_LOCKED && in->mode != WC_MODE_OPEN) { status |= WC_STATUS_TORQUE_INVALID; }
         const wc_calibration_t *cal = model->cal;
         inv.current_mA = (in->mode == WC_MODE_LOCKED) ? cal->vfs_current_max_mA : cal->vfs_current_min_mA;
-        inv.force_N = wc_contact_force_N(cal, cal->vfs_gain_Pa_per_mA * inv.current_mA);
+        inv.force_N = wc_contact_force_at(cal, cal->vfs_gain_Pa_per_mA * inv.current_mA);
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
@@ -83,9 +83,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     out->inverse_iterations = inv.iterations;
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;
 
-    clutch->pressure_model_Pa = wc_vfs_lag_step(model, clutch->pressure_model_Pa, inv.current_mA);
+    clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
-    float force_N = wc_contact_force_N(model->cal, clutch->pressure_model_Pa);
+    float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
     const bool bench_force = in->bench.valid && wc_in_range(in->bench.apply_force_N, 0.0f, WC_FORCE_MAX_N);
     const bool bench_torque = in->bench.valid &&
                               wc_in_range(in->bench.torque_Nm, -WC_TORQUE_MAX_Nm, WC_TORQUE_MAX_Nm);

@@ -44,6 +44,32 @@ static inline float wc_thermal_advance(const wc_model_t *model, float theta_degC
          : ((next_degC <= WC_THETA_MAX_degC) ? next_degC : WC_THETA_MAX_degC);
 }
 
+/* The hydraulics of wc_hydraulics.h for the inputs the clutch step produces
+ * (a force in [0, F_max], a finite pressure, a current in the solenoid's
+ * range, a finite reached pressure): the public functions limit any input,
+ * these skip that on the hot path. */
+static inline float wc_piston_pressure_at(const wc_calibration_t *cal, float force_N)
+{
+    return (force_N + cal->return_spring_force_N) / cal->piston_area_m2;  /* P = (F_app + F_s) / A_p */
+}
+
+static inline float wc_contact_force_at(const wc_calibration_t *cal, float pressure_Pa)
+{
+    const float force_N = pressure_Pa * cal->piston_area_m2 - cal->return_spring_force_N;
+    return (force_N > 0.0f) ? force_N : 0.0f;  /* the spring holds the pack open */
+}
+
+static inline float wc_vfs_lag_at(const wc_model_t *model, float pressure_reached_Pa, float current_mA)
+{
+    /* tau dP/dt = K i - P, exact for i held over the period */
+    const float target_Pa = model->cal->vfs_gain_Pa_per_mA * current_mA;
+    return target_Pa + (pressure_reached_Pa - target_Pa) * model->vfs_decay;
+}
+
+/* eq. 18 without the input clamping of wc_friction_coefficient: the theta must
+ * be in [WC_THETA_MIN_degC, WC_THETA_MAX_degC] (src/model/wc_friction.c). */
+float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float theta_degC);
+
 /* e^x within 2 ulp of expf on [-87, 88], in about a third of newlib's
  * instructions (src/model/wc_exp.c; tests/c/test_exp.c). */
 float wc_exp(float x);

@@ -25,7 +25,7 @@
 static void finish(const wc_model_t *model, float force_N, wc_status_t *status, wc_inverse_t *out)
 {
     out->force_N = force_N;
-    out->pressure_Pa = wc_piston_pressure_Pa(model->cal, force_N);
+    out->pressure_Pa = wc_piston_pressure_at(model->cal, force_N);
     *status |= wc_vfs_current_mA(model->cal, out->pressure_Pa, &out->current_mA);
 }
 

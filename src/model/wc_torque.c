@@ -13,7 +13,7 @@ void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC
 {
     const wc_calibration_t *cal = model->cal;
     const float speed_m_s = model->effective_radius_m * fabsf(slip_rad_s);                  /* eq. 4 */
-    point->mu_f = wc_friction_coefficient(cal, speed_m_s, theta_degC);                     /* eq. 18 */
+    point->mu_f = wc_friction_at(cal, speed_m_s, theta_degC);                              /* eq. 18 */
     point->coulomb_Nm_per_N = model->torque_arm_m * point->mu_f;                            /* eq. 6 */
     point->viscous_Nm_m = model->torque_arm_m * wc_viscosity_Pa_s(cal, theta_degC) *        /* eq. 2, 7 */
                           cal->friction_area_m2 * speed_m_s;

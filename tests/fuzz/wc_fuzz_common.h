@@ -92,7 +92,7 @@ void fz_fail(const char *harness_file, int line, const char *condition, const ch
 static inline bool fz_finite(float x) { return isfinite(x) != 0; }
 
 /* Environment switch read once (WC_FUZZ_VERBOSE=1 prints a summary per input;
- * WC_FUZZ_STRICT=1 also checks the arithmetic helpers outside their
+ * WC_FUZZ_LAX=1 checks the arithmetic helpers only inside their
  * documented domain, see tests/fuzz/README.md). */
 bool fz_env_flag(const char *name);
 
