@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # All tests: installs what is missing, builds the host (sanitized) and the
-# Cortex-M4F presets, runs the C unit tests (ctest) and the Python tests (pytest).
+# Cortex-M4F presets, runs static analysis, the Cortex-M4F checks and
+# instruction counts, the package check, the fuzzers (60 s each), the C unit
+# tests (ctest) and the Python tests (pytest).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
