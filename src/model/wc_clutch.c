@@ -60,16 +60,14 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 
     out->theta_degC = clutch->theta_degC;
     /* The inverse and the forward torque see the same (slip, theta): mu_f and
-     * mu_v once per step. The held slip and request are valid; an invalid
-     * temperature estimate gets the documented answers of wc_inverse and
-     * wc_torque to rejected input. */
-    const bool point_valid = wc_theta_valid(clutch->theta_degC);
-    wc_torque_point_t point = { 0.0f, 0.0f, 0.0f };
-    if (point_valid) { wc_torque_point(model, u->slip_rad_s, clutch->theta_degC, &point); }
+     * mu_v once per step. Every input of the point is valid: the held slip and
+     * request by accept_inputs, the estimate by init and the thermal envelope. */
+    WC_ASSERT(wc_theta_valid(clutch->theta_degC));
+    wc_torque_point_t point;
+    wc_torque_point(model, u->slip_rad_s, clutch->theta_degC, &point);
     wc_inverse_t inv;
     if (in->mode == WC_MODE_TORQUE) {
-        status |= point_valid ? wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv)
-                              : wc_inverse_rejected(model, WC_STATUS_THETA_INVALID, &inv);
+        status |= wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv);
     } else {
         if (in->mode != WC_MODE_LOCKED && in->mode != WC_MODE_OPEN) { status |= WC_STATUS_TORQUE_INVALID; }
         const wc_calibration_t *cal = model->cal;
@@ -92,14 +90,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (in->bench.valid && !bench_force) { status |= WC_STATUS_FORCE_INVALID; }
     if (in->bench.valid && !bench_torque) { status |= WC_STATUS_TORQUE_INVALID; }
     if (bench_force) { force_N = in->bench.apply_force_N; }
-    const bool force_valid = wc_in_range(force_N, 0.0f, WC_FORCE_MAX_N);
-    if (point_valid && force_valid) {
-        wc_torque_at_point(model, &point, u->slip_rad_s, force_N, &out->model);
-    } else {
-        status |= (point_valid ? WC_STATUS_OK : WC_STATUS_THETA_INVALID) |
-                  (force_valid ? WC_STATUS_OK : WC_STATUS_FORCE_INVALID);
-        wc_torque_rejected(model, &out->model);
-    }
+    /* valid: the modelled force is in [0, F_max] (F_max <= WC_FORCE_MAX_N by the
+     * calibration check), the bench force was range-checked above */
+    wc_torque_at_point(model, &point, u->slip_rad_s, force_N, &out->model);
 
     /* eq. 1 heat input: friction power |T dw| */
     const float heat_torque_Nm = bench_torque ? in->bench.torque_Nm : out->model.torque_Nm;

@@ -171,7 +171,8 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
     return status;
 }
 
-wc_status_t wc_inverse_rejected(const wc_model_t *model, wc_status_t status, wc_inverse_t *out)
+/* The documented answer to rejected input (wc_inverse.h): no contact force. */
+static wc_status_t wc_inverse_rejected(const wc_model_t *model, wc_status_t status, wc_inverse_t *out)
 {
     out->iterations = 0u;
     finish(model, 0.0f, &status, out);  /* documented safe answer: no contact force */

@@ -29,13 +29,6 @@ void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point,
 wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
                                 wc_inverse_t *out);
 
-/* The documented answers to rejected input (wc_torque.h, wc_inverse.h):
- * zero torque with the open-clutch film; no contact force. status carries
- * the input bits and gains the current clamp bit if the preload current is
- * outside the solenoid range. */
-void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out);
-wc_status_t wc_inverse_rejected(const wc_model_t *model, wc_status_t status, wc_inverse_t *out);
-
 /* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]
  * (p = p_k + t (p_k+1 - p_k)): h_bar(t) = c[0] + t (c[1] + t (c[2] + t c[3])).
  * The same cubic Hermite as wc_film_hbar_m (wc_film.c), in the power basis

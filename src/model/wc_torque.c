@@ -19,7 +19,8 @@ void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC
                           cal->friction_area_m2 * speed_m_s;
 }
 
-void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out)
+/* The documented answer to rejected input (wc_torque.h): zero torque with the open-clutch film. */
+static void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out)
 {
     out->torque_Nm = 0.0f;
     out->coulomb_Nm = 0.0f;
