@@ -61,6 +61,12 @@ static float torque_bound_Nm;  /* mu_f 1 at WC_FORCE_MAX_N plus the largest visc
 static bool in_range(float x, float lo, float hi) { return (x >= lo) && (x <= hi); }
 static bool slip_ok(float x) { return in_range(x, -WC_SLIP_MAX_rad_s, WC_SLIP_MAX_rad_s); }
 static bool theta_ok(float x) { return in_range(x, WC_THETA_MIN_degC, WC_THETA_MAX_degC); }
+
+/* The input bits every model call must raise for its operating point. */
+static wc_status_t operating_point_bits(float slip, float theta)
+{
+    return (slip_ok(slip) ? 0u : WC_STATUS_SLIP_INVALID) | (theta_ok(theta) ? 0u : WC_STATUS_THETA_INVALID);
+}
 static bool same_bits(float a, float b) { return fz_bits_of(a) == fz_bits_of(b); }
 static bool close_rel(float a, float b, float rel, float abs_tol)
 {
@@ -156,8 +162,7 @@ static void op_torque(fz_reader_t *r, unsigned step)
     fz_arg(slip); fz_arg(theta); fz_arg(force);
     wc_torque_t t;
     const wc_status_t st = wc_torque(&model, slip, theta, force, &t);
-    const wc_status_t expected = (slip_ok(slip) ? 0u : WC_STATUS_SLIP_INVALID) |
-                                 (theta_ok(theta) ? 0u : WC_STATUS_THETA_INVALID) |
+    const wc_status_t expected = operating_point_bits(slip, theta) |
                                  (in_range(force, 0.0f, WC_FORCE_MAX_N) ? 0u : WC_STATUS_FORCE_INVALID);
     FZ_CHECK(st == expected, "status 0x%x, expected exactly 0x%x", (unsigned)st, (unsigned)expected);
     check_torque_output(&t, slip, expected != 0u, force);
@@ -181,8 +186,7 @@ static void op_inverse(fz_reader_t *r, unsigned step)
     fz_arg(slip); fz_arg(theta); fz_arg(request);
     wc_inverse_t inv;
     const wc_status_t st = wc_inverse(&model, slip, theta, request, &inv);
-    const wc_status_t invalid = (slip_ok(slip) ? 0u : WC_STATUS_SLIP_INVALID) |
-                                (theta_ok(theta) ? 0u : WC_STATUS_THETA_INVALID) |
+    const wc_status_t invalid = operating_point_bits(slip, theta) |
                                 (in_range(request, 0.0f, WC_TORQUE_MAX_Nm) ? 0u : WC_STATUS_TORQUE_INVALID);
     FZ_CHECK((st & WC_STATUS_INPUT_INVALID) == invalid, "input bits 0x%x, expected 0x%x", (unsigned)st,
              (unsigned)invalid);
