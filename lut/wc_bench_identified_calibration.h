@@ -30,6 +30,12 @@ static const wc_calibration_t wc_bench_identified_calibration = {
     .vfs_current_min_mA = 0.0f, /* mA; project default: solenoid range 0-1000 mA (issue 3) */
     .vfs_current_max_mA = 1000.0f, /* mA; project default: solenoid range 0-1000 mA (issue 3) */
     .control_period_s = 0.001f, /* s; project default: 1 ms control period (DESIGN 4) */
+    .film_squeeze_factor = 0.0f, /* 1; not identified yet: film state off */
+    .static_friction_factor = 1.0f, /* 1; not identified yet: project default */
+    .lock_slip_rad_s = 0.3f, /* rad/s; project default: lock band 2.9 rpm (6 sigma of a 0.5 rpm speed sensor) */
+    .breakaway_slip_rad_s = 0.8f, /* rad/s; project default: breakaway band 7.6 rpm (hysteresis above the lock band) */
+    .lock_dwell_periods = 10u, /* 1; project default: 10 control periods (10 ms) inside the lock band before locking */
+    .holding_margin = 0.2f, /* 1; project default: a locked clutch is held at 1.2 times the force the request needs */
     .heat_capacity_J_per_K = 287.30515f, /* J/K; eq. 1: N_c((m c_p)_lining + (m c_p)_separator) from the thermal section */
     .film = { wc_bench_identified_film_pressure_Pa, wc_bench_identified_film_hbar_m, wc_bench_identified_film_slope_m_per_Pa, WC_BENCH_IDENTIFIED_FILM_NODES },
 };

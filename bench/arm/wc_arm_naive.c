@@ -106,8 +106,8 @@ wc_status_t wc_arm_naive_inverse(const wc_model_t *model, float slip_rad_s, floa
     /* The same per-point terms as the library (eq. 2, 4, 6, 7, 18). */
     const float speed_m_s = model->effective_radius_m * fabsf(slip_rad_s);
     naive_point_t point;
-    point.coulomb_Nm_per_N = model->torque_arm_m * wc_friction_coefficient(cal, speed_m_s, theta_degC);
-    point.viscous_Nm_m = model->torque_arm_m * wc_viscosity_Pa_s(cal, theta_degC) * cal->friction_area_m2 * speed_m_s;
+    point.coulomb_Nm_per_N = (model->effective_radius_m * (float)model->cal->friction_pairs) * wc_friction_coefficient(cal, speed_m_s, theta_degC);
+    point.viscous_Nm_m = (model->effective_radius_m * (float)model->cal->friction_pairs) * wc_viscosity_Pa_s(cal, theta_degC) * cal->friction_area_m2 * speed_m_s;
     point.area_m2 = cal->friction_area_m2;
 
     if (torque_request_Nm <= naive_torque_Nm(&point, 0.0f)) {

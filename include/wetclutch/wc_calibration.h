@@ -39,6 +39,13 @@ typedef struct {
     float vfs_current_min_mA;
     float vfs_current_max_mA;
     float control_period_s;            /* dt of one wc_clutch_step */
+    /* Engagement edges (DESIGN section 9) */
+    float film_squeeze_factor;         /* phi of the Reynolds squeeze film; 0: film state off (eq. 16, steady) */
+    float static_friction_factor;      /* static capacity / (mu_f(0, theta) R_eff N_c F_c) */
+    float lock_slip_rad_s;             /* |slip| below it for lock_dwell_periods: locked */
+    float breakaway_slip_rad_s;        /* |slip| above it while locked: breakaway (> lock_slip_rad_s) */
+    float holding_margin;              /* a locked clutch is held at (1 + margin) times the request's force */
+    uint32_t lock_dwell_periods;       /* control periods inside the lock band before locking */
     wc_film_table_t film;
 } wc_calibration_t;
 
@@ -74,6 +81,12 @@ typedef enum {
     WC_CAL_VFS_CURRENT_MAX,     /* also: not above the minimum, a piston force K i_max A_p above
                                  * WC_FORCE_MAX_N, or not above the spring force F_s (cannot apply) */
     WC_CAL_CONTROL_PERIOD,
+    WC_CAL_FILM_SQUEEZE_FACTOR, /* also: neither 0 (off) nor >= WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MIN */
+    WC_CAL_STATIC_FRICTION_FACTOR,
+    WC_CAL_LOCK_SLIP,
+    WC_CAL_BREAKAWAY_SLIP,      /* also: not above the lock band */
+    WC_CAL_HOLDING_MARGIN,
+    WC_CAL_LOCK_DWELL,
     WC_CAL_FILM_TABLE,          /* missing arrays, bad length, non-finite entry */
     WC_CAL_FILM_AXIS_NOT_MONOTONE,
     WC_CAL_CONDUCTANCE_SUM,     /* k1 + k2 below WC_CAL_LIMIT_CONDUCTANCE_SUM_MIN_W_per_K */
@@ -156,6 +169,25 @@ typedef enum {
  * alpha = s_k / Delta_k, beta = s_k+1 / Delta_k, alpha, beta >= 0 and
  * alpha^2 + beta^2 <= 9 make the cubic Hermite on [p_k, p_k+1] monotone. */
 #define WC_CAL_LIMIT_FRITSCH_CARLSON 9.0f
+/* Squeeze film (DESIGN section 9): phi = 0 switches the film state off; else
+ * phi in [1e-4, 1]. phi <= 1: grooves and a permeable lining only let the oil
+ * out faster than between smooth plates. The lower bound keeps the film's
+ * damping 3 pi phi mu_v K / 2 a normal float (mu_v >= its domain minimum);
+ * the update is stable for any damping (wc_film_advance_m). */
+#define WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MIN 1e-4f
+#define WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MAX 1.0f
+/* Static capacity factor in [0.5, 2]: static over kinetic-at-zero-speed
+ * friction of wet pairs is 1.0..1.3. */
+#define WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MIN 0.5f
+#define WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MAX 2.0f
+/* Lock band (0, 10] rad/s (95 rpm) and breakaway band (lock band, 20] rad/s:
+ * lock-up detection, not slip control. */
+#define WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s 10.0f
+#define WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s 20.0f
+/* Holding margin in [0, 1]: up to twice the request's force. */
+#define WC_CAL_LIMIT_HOLDING_MARGIN_MAX 1.0f
+/* Lock dwell 1..255 periods: the firmware counts it in 8 bits. */
+#define WC_CAL_LIMIT_LOCK_DWELL_MAX_periods 255u
 
 /* Check every field against the limits above, and the relations between
  * fields that the equations need (DESIGN section 8): radii ordered, mu_v and

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "wc_inverse.h"
+#include "wc_lockup.h"
 #include "wc_model.h"
 #include "wc_status.h"
 #include "wc_torque.h"
@@ -47,7 +48,9 @@ typedef struct {
     float pressure_model_Pa;    /* pressure the lagged VFS is modelled to reach */
     float force_command_N;      /* contact force the inverse asked for */
     float theta_degC;           /* friction-surface temperature used this step */
-    wc_torque_t model;          /* torque model at the modelled pressure */
+    float contact_force_N;      /* F_c the torque model used: the apply force, or the squeeze film's asperity force */
+    float static_capacity_Nm;   /* static capacity at that force (DESIGN 9) */
+    wc_torque_t model;          /* torque model at the modelled pressure; while locked the held torque */
     uint32_t inverse_iterations;
     wc_status_t status;
 } wc_step_output_t;
@@ -65,6 +68,8 @@ typedef struct {
     float theta_degC;           /* observer state, in [WC_THETA_MIN_degC, WC_THETA_MAX_degC] */
     float pressure_model_Pa;    /* VFS lag state */
     wc_held_inputs_t held;
+    float film_hbar_m;          /* squeeze-film state h_bar (DESIGN 9); the steady film when it is off */
+    wc_lockup_t lockup;         /* slipping / locked (DESIGN 9) */
     bool over_temperature;      /* WC_STATUS_OVER_TEMPERATURE with hysteresis */
 } wc_clutch_t;
 
@@ -77,13 +82,20 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *     value (held) and flagged, so one bad sample changes no state with a
  *     bad number;
  *  2. WC_MODE_TORQUE: inverse at the current temperature estimate -> current
- *     command; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
+ *     command (a locked clutch: the force that holds the request with the
+ *     holding margin); WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
  *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
  *     WC_STATUS_TORQUE_INVALID);
- *  3. VFS lag -> modelled pressure -> contact force (on a bench: the measured
- *     apply force) -> torque model;
- *  4. observer advanced with P = |T dw|, T the model torque (on a bench: the
- *     measured torque), kept in the thermal envelope; above
+ *  3. VFS lag -> modelled pressure -> apply force (on a bench: the measured
+ *     apply force) -> contact force (the apply force, eq. 16; with the film
+ *     state on, the asperity force at the squeeze film, which then advances
+ *     under the apply force) -> torque model;
+ *  4. lock-up (wc_lockup.h) with the torque the clutch must carry (on a
+ *     bench: the measured torque; else the request in the lock direction)
+ *     against the static capacity; while locked the estimate is the held
+ *     torque (wc_lockup_torque_Nm) and WC_STATUS_LOCKED is set;
+ *  5. observer advanced with P = |T dw| (0 while locked), T the model torque
+ *     (on a bench: the measured torque), kept in the thermal envelope; above
  *     WC_THETA_OVER_degC WC_STATUS_OVER_TEMPERATURE is set until the estimate
  *     falls WC_THETA_OVER_HYSTERESIS_K below it. Implausible bench values are
  *     flagged and not used.

@@ -9,11 +9,11 @@
 typedef struct {
     const wc_calibration_t *cal;
     float effective_radius_m;   /* R_eff, eq. 3 */
-    float torque_arm_m;         /* R_eff N_c: torque per unit of friction force, eq. 6-8 */
     float force_max_N;          /* contact force at the solenoid's maximum current */
     float hbar_at_force_max_m;  /* h_bar(force_max_N / A_f): the inverse's saturation test */
     float thermal_decay;        /* a = exp(-(k1 + k2) dt / C), eq. 1 exact ZOH */
     float vfs_decay;            /* exp(-dt / tau), VFS first-order lag */
+    float film_damping_m4;      /* 3 pi phi K / 2: the squeeze film's damping per unit of mu_v (DESIGN 9); 0: off */
 } wc_model_t;
 
 /* Validate cal (wc_calibration_check) and derive the constants. On error the

@@ -19,6 +19,7 @@ typedef uint32_t wc_status_t;
 #define WC_STATUS_POWER_INVALID    (1u << 7)  /* heat input NaN, infinite or negative */
 #define WC_STATUS_OVER_TEMPERATURE (1u << 8)  /* temperature estimate above WC_THETA_OVER_degC (hysteresis) */
 #define WC_STATUS_NOT_INITIALISED  (1u << 9)  /* NULL or uninitialised instance (asserts off): zero outputs */
+#define WC_STATUS_LOCKED           (1u << 10) /* clutch locked: static friction holds it (DESIGN 9); not an error */
 
 /* Any of the input-rejection bits. */
 #define WC_STATUS_INPUT_INVALID \

@@ -13,6 +13,7 @@
 #include "wc_thermal.h"
 #include "wc_hydraulics.h"
 #include "wc_inverse.h"
+#include "wc_lockup.h"
 #include "wc_clutch.h"
 
 /* rpm <-> rad/s, for callers whose sensors speak rpm. */

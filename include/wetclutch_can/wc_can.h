@@ -88,6 +88,9 @@ extern "C" {
 
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_SNA_CHOICE (4095u)
 
+#define WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_SLIPPING_CHOICE (0u)
+#define WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_LOCKED_CHOICE (1u)
+
 #define WC_CAN_CLUTCH_ESTIMATE_MODEL_TORQUE_SNA_CHOICE (-32768)
 
 #define WC_CAN_CLUTCH_ESTIMATE_MU_F_SNA_CHOICE (65535u)
@@ -135,7 +138,9 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_STATUS_BENCH_INPUT_NAME "StatusBenchInput"
 #define WC_CAN_VFS_COMMAND_STATUS_FRAME_LOST_NAME "StatusFrameLost"
 #define WC_CAN_VFS_COMMAND_STATUS_BUS_ERROR_NAME "StatusBusError"
+#define WC_CAN_VFS_COMMAND_STATUS_LOCKED_NAME "StatusLocked"
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_NAME "EstimatedClutchTemp"
+#define WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_NAME "LockState"
 #define WC_CAN_CLUTCH_ESTIMATE_MODEL_TORQUE_NAME "ModelTorque"
 #define WC_CAN_CLUTCH_ESTIMATE_MU_F_NAME "MuF"
 #define WC_CAN_CLUTCH_ESTIMATE_FILM_THICKNESS_NAME "FilmThickness"
@@ -404,13 +409,22 @@ struct wc_can_vfs_command_t {
     uint8_t status_frame_lost;
 
     /**
-     * Status bit 13: the CAN controller reported a bus error (error passive, bus-off, controller problem) or a transmit failed since the previous VfsCommand. Bits 14..15 (frame bits 62..63) are reserved and sent as 0.
+     * Status bit 13: the CAN controller reported a bus error (error passive, bus-off, controller problem) or a transmit failed since the previous VfsCommand.
      *
      * Range: 0..1 (0..1 -)
      * Scale: 1
      * Offset: 0
      */
     uint8_t status_bus_error;
+
+    /**
+     * Status bit 14: the clutch is locked (static friction holds it, DESIGN.md section 9); not a fault. Bit 15 (frame bit 63) is reserved and sent as 0.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_locked;
 };
 
 /**
@@ -429,6 +443,15 @@ struct wc_can_clutch_estimate_t {
      * Offset: -50
      */
     uint16_t estimated_clutch_temp;
+
+    /**
+     * Lock-up state of the clutch (DESIGN.md section 9): 0 slipping (ModelTorque is the kinetic model, eq. 5-8), 1 locked (ModelTorque is the torque the static friction holds, bounded by the static capacity, sign of the slip before the lock).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t lock_state;
 
     /**
      * Model clutch torque (eq. 5-8), signed with the slip direction. 0.1 Nm/bit signed 16 bit: +-3276.7 Nm, valid +-3000 Nm. Raw -32768 = SNA (the encoder maps NaN to it).
@@ -1200,6 +1223,28 @@ bool wc_can_vfs_command_status_bus_error_is_in_range(uint8_t value);
 bool wc_can_vfs_command_status_bus_error_is_in_phys_range(float value);
 
 /**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_vfs_command_status_locked_is_in_phys_range(float value);
+
+/**
  * Pack message ClutchEstimate.
  *
  * @param[out] dst_p Buffer to pack the message into.
@@ -1257,6 +1302,28 @@ bool wc_can_clutch_estimate_estimated_clutch_temp_is_in_range(uint16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_clutch_estimate_estimated_clutch_temp_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_clutch_estimate_lock_state_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_clutch_estimate_lock_state_is_in_phys_range(float value);
 
 /**
  * Check that given signal is in allowed range.

@@ -29,9 +29,10 @@ extern "C" {
 #define WC_CAN_STATUS_BENCH_INPUT (1u << 11)
 #define WC_CAN_STATUS_FRAME_LOST (1u << 12)
 #define WC_CAN_STATUS_BUS_ERROR (1u << 13)
-/** Bits 14..15 are reserved: ignored by the encoder, sent as 0. */
-#define WC_CAN_STATUS_DEFINED_MASK 0x3FFFu
-#define WC_CAN_STATUS_BITS 14u
+#define WC_CAN_STATUS_LOCKED (1u << 14)
+/** Bits 15..15 are reserved: ignored by the encoder, sent as 0. */
+#define WC_CAN_STATUS_DEFINED_MASK 0x7FFFu
+#define WC_CAN_STATUS_BITS 15u
 
 /* One descriptor per scaled signal (message_signal). */
 extern const wc_can_signal_t wc_can_sig_clutch_sensors_slip_speed; /* rpm */
@@ -77,6 +78,7 @@ typedef struct {
     float model_torque_Nm;
     float mu_f;
     float film_thickness_um;
+    uint8_t lock_state; /**< WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_*_CHOICE */
 } wc_can_clutch_estimate_phys_t;
 
 /** BenchMeasurement (0x130) in physical units. */

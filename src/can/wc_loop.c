@@ -192,13 +192,14 @@ static const wc_status_map_t status_map[] = {
     { WC_STATUS_INPUT_INVALID, WC_CAN_STATUS_IMPLAUSIBLE_INPUT },
     { WC_STATUS_OVER_TEMPERATURE, WC_CAN_STATUS_OVER_TEMPERATURE },
     { WC_STATUS_NOT_INITIALISED, WC_CAN_STATUS_SAFE_STATE_ACTIVE },
+    { WC_STATUS_LOCKED, WC_CAN_STATUS_LOCKED },
 };
 
 static uint16_t status_bits(wc_status_t status)
 {
     uint16_t bits = 0u;
 #if defined(__GNUC__) && !defined(__clang__) && !defined(__OPTIMIZE_SIZE__)
-#pragma GCC unroll 8  /* six fixed entries, every period (bench/arm) */
+#pragma GCC unroll 8  /* seven fixed entries, every period (bench/arm) */
 #endif
     for (size_t i = 0u; i < (sizeof status_map / sizeof status_map[0]); ++i) {
         if ((status & status_map[i].model) != 0u) { bits = (uint16_t)(bits | status_map[i].can); }
@@ -216,6 +217,8 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
         .model_torque_Nm = o->model.torque_Nm,
         .mu_f = o->model.mu_f,
         .film_thickness_um = o->model.hbar_m * 1.0e6f,
+        .lock_state = ((o->status & WC_STATUS_LOCKED) != 0u) ? (uint8_t)WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_LOCKED_CHOICE
+                                                             : (uint8_t)WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_SLIPPING_CHOICE,
     };
     out[1].id = WC_CAN_CLUTCH_ESTIMATE_FRAME_ID;
     out[1].dlc = WC_CAN_CLUTCH_ESTIMATE_LENGTH;

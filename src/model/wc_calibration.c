@@ -85,12 +85,19 @@ static const wc_field_limit_t field_limits[] = {
     WC_FIELD(vfs_current_max_mA, WC_CAL_VFS_CURRENT_MAX, 1u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA), /* and > i_min */
     WC_FIELD(control_period_s, WC_CAL_CONTROL_PERIOD, 0u, WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s,
              WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s),
+    WC_FIELD(film_squeeze_factor, WC_CAL_FILM_SQUEEZE_FACTOR, 0u, 0.0f, WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MAX),
+    WC_FIELD(static_friction_factor, WC_CAL_STATIC_FRICTION_FACTOR, 0u, WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MIN,
+             WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MAX),
+    WC_FIELD(lock_slip_rad_s, WC_CAL_LOCK_SLIP, 1u, 0.0f, WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s),
+    WC_FIELD(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP, 1u, 0.0f, WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s),
+    WC_FIELD(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, 0.0f, WC_CAL_LIMIT_HOLDING_MARGIN_MAX),
 };
 
 /* Every float field has its range: the float fields fill the struct up to
- * the film table, but for friction_pairs (checked after piston_area_m2). */
+ * lock_dwell_periods, but for friction_pairs (checked after piston_area_m2);
+ * the two counts are checked by check_fields. */
 WC_STATIC_ASSERT(sizeof field_limits / sizeof field_limits[0] ==
-                     (offsetof(wc_calibration_t, film) - sizeof(uint32_t)) / sizeof(float),
+                     (offsetof(wc_calibration_t, lock_dwell_periods) - sizeof(uint32_t)) / sizeof(float),
                  every_float_field_has_a_range);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) <= UINT16_MAX, field_offsets_fit_uint16);
 
@@ -106,6 +113,9 @@ static wc_cal_error_t check_fields(const wc_calibration_t *cal)
             ((cal->friction_pairs == 0u) || (cal->friction_pairs > WC_CAL_LIMIT_FRICTION_PAIRS_MAX))) {
             return WC_CAL_FRICTION_PAIRS;  /* in declaration order, after A_p */
         }
+    }
+    if ((cal->lock_dwell_periods == 0u) || (cal->lock_dwell_periods > WC_CAL_LIMIT_LOCK_DWELL_MAX_periods)) {
+        return WC_CAL_LOCK_DWELL;  /* the last scalar field */
     }
     return WC_CAL_OK;
 }
@@ -163,6 +173,14 @@ static wc_cal_error_t check_relations(const wc_calibration_t *cal)
     if (!within(time_constant_s, cal->control_period_s, WC_CAL_LIMIT_TIME_CONSTANT_MAX_s)) {
         return WC_CAL_THERMAL_TIME_CONSTANT;
     }
+
+    /* DESIGN section 9: the film state off (0: the field's range excludes < 0
+     * and NaN), or a squeeze factor the update resolves;
+     * breakaway outside the lock band (the hysteresis that keeps the lock from flapping) */
+    if (!(!(cal->film_squeeze_factor > 0.0f) || (cal->film_squeeze_factor >= WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MIN))) {
+        return WC_CAL_FILM_SQUEEZE_FACTOR;
+    }
+    if (!(cal->breakaway_slip_rad_s > cal->lock_slip_rad_s)) { return WC_CAL_BREAKAWAY_SLIP; }
     return WC_CAL_OK;
 }
 
@@ -246,6 +264,12 @@ static const char *const cal_error_names[] = {
     "vfs_current_min_mA",
     "vfs_current_max_mA",
     "control_period_s",
+    "film_squeeze_factor",
+    "static_friction_factor",
+    "lock_slip_rad_s",
+    "breakaway_slip_rad_s",
+    "holding_margin",
+    "lock_dwell_periods",
     "film (table arrays, length or entries)",
     "film.pressure_Pa (not strictly increasing)",
     "oil_conductance_W_per_K + housing_conductance_W_per_K",

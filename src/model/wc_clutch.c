@@ -3,12 +3,13 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "wetclutch/wc_film.h"
 #include "wetclutch/wc_hydraulics.h"
 #include "wc_internal.h"
 #include "wetclutch/wc_thermal.h"
 #include "wc_operating_point.h"
 
-/* DESIGN section 3 / issue "state <= 64 B per clutch" (48 B on Cortex-M4F, 56 B on a 64-bit host). */
+/* DESIGN section 3 / issue "state <= 64 B per clutch" (60 B on Cortex-M4F, 64 B on a 64-bit host). */
 WC_STATIC_ASSERT(sizeof(wc_clutch_t) <= 64u, clutch_state_fits_in_64_bytes);
 
 wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, float theta_start_degC)
@@ -25,6 +26,10 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
     clutch->held.theta_housing_degC = theta;
     clutch->held.torque_request_Nm = 0.0f;
     clutch->over_temperature = false;
+    /* the film settled under the force of the VFS at rest */
+    clutch->film_hbar_m = wc_film_hbar_m(&cal->film, wc_contact_force_at(cal, clutch->pressure_model_Pa) /
+                                                         cal->friction_area_m2);
+    wc_lockup_init(&clutch->lockup);
     return WC_CAL_OK;
 }
 
@@ -49,7 +54,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     WC_ASSERT((clutch == NULL) || (clutch->model.cal != NULL));  /* initialised, and its init succeeded */
     if ((clutch == NULL) || (in == NULL) || (out == NULL)) { return WC_STATUS_NOT_INITIALISED; }
     if (clutch->model.cal == NULL) {
-        static const wc_step_output_t released = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
+        static const wc_step_output_t released = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
                                                    { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f }, 0u, WC_STATUS_NOT_INITIALISED };
         *out = released;  /* no calibration: no current at all */
         return WC_STATUS_NOT_INITIALISED;
@@ -66,7 +71,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     wc_torque_point_t point;
     wc_torque_point(model, u->slip_rad_s, clutch->theta_degC, &point);
     wc_inverse_t inv;
-    if (in->mode == WC_MODE_TORQUE) {
+    if ((in->mode == WC_MODE_TORQUE) && clutch->lockup.locked) {
+        status |= wc_inverse_holding_at_point(model, &point, u->torque_request_Nm, &inv);  /* DESIGN 9 */
+    } else if (in->mode == WC_MODE_TORQUE) {
         status |= wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv);
     } else {
         if (in->mode != WC_MODE_LOCKED && in->mode != WC_MODE_OPEN) { status |= WC_STATUS_TORQUE_INVALID; }
@@ -92,11 +99,36 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (bench_force) { force_N = in->bench.apply_force_N; }
     /* valid: the modelled force is in [0, F_max] (F_max <= WC_FORCE_MAX_N by the
      * calibration check), the bench force was range-checked above */
-    wc_torque_at_point(model, &point, u->slip_rad_s, force_N, &out->model);
+    const wc_calibration_t *cal = model->cal;
+    if (model->film_damping_m4 > 0.0f) {
+        /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
+         * squeeze film carries the rest, and the film advances under the force. */
+        const float hbar_m = clutch->film_hbar_m;
+        const float contact_N = cal->friction_area_m2 * wc_film_pressure_Pa(&cal->film, hbar_m);
+        wc_torque_at_film(&point, u->slip_rad_s, contact_N, hbar_m, &out->model);
+        out->contact_force_N = contact_N;
+        clutch->film_hbar_m = wc_film_advance_m(&cal->film, cal->friction_area_m2, hbar_m, force_N,
+                                                model->film_damping_m4 * point.viscosity_Pa_s, cal->control_period_s);
+    } else {
+        wc_torque_at_point(model, &point, u->slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
+        out->contact_force_N = force_N;
+    }
 
-    /* eq. 1 heat input: friction power |T dw| */
+    /* DESIGN 9: lock-up against the static capacity at the contact force. */
+    out->static_capacity_Nm = point.static_Nm_per_N * out->contact_force_N;
+    const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
+    const float required_Nm = bench_torque ? in->bench.torque_Nm : direction * u->torque_request_Nm;
+    const bool locked = wc_lockup_update(&clutch->lockup, cal, u->slip_rad_s, required_Nm, out->static_capacity_Nm);
+    if (locked) {
+        out->model.torque_Nm = wc_lockup_torque_Nm(&clutch->lockup, required_Nm, out->static_capacity_Nm);
+        out->model.coulomb_Nm = out->model.torque_Nm;  /* static friction only: no slip, no viscous shear */
+        out->model.viscous_Nm = 0.0f;
+        status |= WC_STATUS_LOCKED;
+    }
+
+    /* eq. 1 heat input: friction power |T dw|; none while locked */
     const float heat_torque_Nm = bench_torque ? in->bench.torque_Nm : out->model.torque_Nm;
-    const float power_W = fabsf(heat_torque_Nm * u->slip_rad_s);  /* finite: model or range-checked bench torque */
+    const float power_W = locked ? 0.0f : fabsf(heat_torque_Nm * u->slip_rad_s);  /* finite: model or range-checked */
     clutch->theta_degC = wc_thermal_advance(model, clutch->theta_degC, power_W, u->theta_oil_degC,
                                             u->theta_housing_degC);  /* the held temperatures are valid */
     /* Over-temperature with hysteresis on the updated estimate (DESIGN section 8). */

@@ -16,6 +16,8 @@ typedef struct {
     float coulomb_Nm_per_N;  /* R_eff N_c mu_f(v, theta), eq. 6 */
     float viscous_Nm_m;      /* R_eff N_c mu_v(theta) A_f v, eq. 7 times h_bar */
     float mu_f;
+    float viscosity_Pa_s;    /* mu_v(theta), eq. 2: the squeeze film's damping (DESIGN 9) */
+    float static_Nm_per_N;   /* static capacity per newton of contact force (DESIGN 9) */
 } wc_torque_point_t;
 
 /* mu_f, mu_v at a valid (slip, theta). */
@@ -28,6 +30,17 @@ void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point,
 /* The inverse at the point for a valid torque_request_Nm (wc_inverse.h). */
 wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
                                 wc_inverse_t *out);
+
+/* The inverse for a locked clutch (DESIGN 9): the force whose static capacity
+ * holds torque_request_Nm with the calibration's holding margin, clamped to
+ * the force at the maximum current (WC_STATUS_SATURATED). */
+wc_status_t wc_inverse_holding_at_point(const wc_model_t *model, const wc_torque_point_t *point,
+                                        float torque_request_Nm, wc_inverse_t *out);
+
+/* eq. 5-8 at the point for a contact force and the film it stands on (the
+ * steady film of eq. 16, or the squeeze-film state of DESIGN 9). */
+void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N, float hbar_m,
+                       wc_torque_t *out);
 
 /* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]
  * (p = p_k + t (p_k+1 - p_k)): h_bar(t) = c[0] + t (c[1] + t (c[2] + t c[3])).

@@ -110,6 +110,11 @@ static const float_field_t float_fields[] = {
     FIELD(vfs_current_min_mA, WC_CAL_VFS_CURRENT_MIN),
     FIELD(vfs_current_max_mA, WC_CAL_VFS_CURRENT_MAX),
     FIELD(control_period_s, WC_CAL_CONTROL_PERIOD),
+    FIELD(film_squeeze_factor, WC_CAL_FILM_SQUEEZE_FACTOR),
+    FIELD(static_friction_factor, WC_CAL_STATIC_FRICTION_FACTOR),
+    FIELD(lock_slip_rad_s, WC_CAL_LOCK_SLIP),
+    FIELD(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP),
+    FIELD(holding_margin, WC_CAL_HOLDING_MARGIN),
 };
 
 static void test_table1_is_valid(void **state)
@@ -139,8 +144,8 @@ static void test_field_table_is_complete(void **state)
 {
     (void)state;
     const size_t n = WC_TEST_COUNT(float_fields);
-    /* 24 scalar fields in wc_calibration_t: 23 float + friction_pairs (uint32). */
-    assert_int_equal(n, 23);
+    /* 30 scalar fields in wc_calibration_t: 28 float + friction_pairs and lock_dwell_periods (uint32). */
+    assert_int_equal(n, 28);
     for (size_t i = 0u; i < n; ++i) {
         for (size_t j = i + 1u; j < n; ++j) {
             WC_CHECK(float_fields[i].offset != float_fields[j].offset, "%s twice", float_fields[i].name);
@@ -149,8 +154,11 @@ static void test_field_table_is_complete(void **state)
         WC_CHECK(float_fields[i].offset + sizeof(float) <= offsetof(wc_calibration_t, film), "%s",
                  float_fields[i].name);
     }
-    /* Float fields + friction_pairs + the film table fill the struct up to film. */
-    assert_int_equal(n * sizeof(float) + sizeof(uint32_t), offsetof(wc_calibration_t, film));
+    /* Float fields, friction_pairs and lock_dwell_periods fill the struct up to film (after padding to
+     * the pointers' alignment). */
+    assert_int_equal(n * sizeof(float) + sizeof(uint32_t), offsetof(wc_calibration_t, lock_dwell_periods));
+    assert_true(offsetof(wc_calibration_t, film) - offsetof(wc_calibration_t, lock_dwell_periods) <=
+                sizeof(uint32_t) + sizeof(void *));
 }
 
 /* NaN and +-Inf in any field: that field's code (every rule rejects them). */
@@ -283,6 +291,19 @@ static const variant_t rejected_variants[] = {
     V1(WC_CAL_CONTROL_PERIOD, control_period_s, 0.0f),
     V1(WC_CAL_CONTROL_PERIOD, control_period_s, 5e-5f),
     V1(WC_CAL_CONTROL_PERIOD, control_period_s, 0.2f),
+    /* engagement edges (DESIGN 9) */
+    V1(WC_CAL_FILM_SQUEEZE_FACTOR, film_squeeze_factor, -0.1f),
+    V1(WC_CAL_FILM_SQUEEZE_FACTOR, film_squeeze_factor, 1.5f),
+    V1(WC_CAL_FILM_SQUEEZE_FACTOR, film_squeeze_factor, 1e-5f),    /* neither off nor resolvable */
+    V1(WC_CAL_STATIC_FRICTION_FACTOR, static_friction_factor, 0.4f),
+    V1(WC_CAL_STATIC_FRICTION_FACTOR, static_friction_factor, 2.5f),
+    V1(WC_CAL_LOCK_SLIP, lock_slip_rad_s, 0.0f),
+    V1(WC_CAL_LOCK_SLIP, lock_slip_rad_s, 11.0f),
+    V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 0.0f),
+    V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 25.0f),
+    V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 0.3f),          /* == the lock band: no hysteresis */
+    V1(WC_CAL_HOLDING_MARGIN, holding_margin, -0.01f),
+    V1(WC_CAL_HOLDING_MARGIN, holding_margin, 1.5f),
     /* relations of several fields */
     V2(WC_CAL_CONDUCTANCE_SUM, oil_conductance_W_per_K, 1e-40f, housing_conductance_W_per_K, 0.0f),  /* issue 10 */
     V2(WC_CAL_CONDUCTANCE_SUM, oil_conductance_W_per_K, 5e-4f, housing_conductance_W_per_K, 4e-4f),
@@ -469,6 +490,26 @@ static void test_friction_pairs(void **state)
         expect_code(&c.cal, WC_CAL_OK, "friction_pairs", (double)good[k]);
     }
     assert_string_equal(wc_cal_error_name(WC_CAL_FRICTION_PAIRS), "friction_pairs");
+}
+
+static void test_lock_dwell(void **state)
+{
+    (void)state;
+    const uint32_t bad[] = { 0u, WC_CAL_LIMIT_LOCK_DWELL_MAX_periods + 1u, UINT32_MAX };
+    for (size_t k = 0u; k < WC_TEST_COUNT(bad); ++k) {
+        cal_copy_t c;
+        copy_table1(&c);
+        c.cal.lock_dwell_periods = bad[k];
+        expect_code(&c.cal, WC_CAL_LOCK_DWELL, "lock_dwell_periods", (double)bad[k]);
+    }
+    const uint32_t good[] = { 1u, WC_CAL_LIMIT_LOCK_DWELL_MAX_periods };
+    for (size_t k = 0u; k < WC_TEST_COUNT(good); ++k) {
+        cal_copy_t c;
+        copy_table1(&c);
+        c.cal.lock_dwell_periods = good[k];
+        expect_code(&c.cal, WC_CAL_OK, "lock_dwell_periods", (double)good[k]);
+    }
+    assert_string_equal(wc_cal_error_name(WC_CAL_LOCK_DWELL), "lock_dwell_periods");
 }
 
 static void test_inner_radius_not_below_outer(void **state)
@@ -879,7 +920,6 @@ static void bind_unchecked(wc_model_t *model, const wc_calibration_t *cal)
     const float ro = cal->outer_radius_m;
     const float ri = cal->inner_radius_m;
     model->effective_radius_m = (2.0f / 3.0f) * (ro * ro + ro * ri + ri * ri) / (ro + ri);
-    model->torque_arm_m = model->effective_radius_m * (float)cal->friction_pairs;
     const float force_N = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 -
                           cal->return_spring_force_N;
     model->force_max_N = (force_N > 0.0f) ? force_N : 0.0f;
@@ -887,6 +927,7 @@ static void bind_unchecked(wc_model_t *model, const wc_calibration_t *cal)
     const float k = cal->oil_conductance_W_per_K + cal->housing_conductance_W_per_K;
     model->thermal_decay = expf(-k * cal->control_period_s / cal->heat_capacity_J_per_K);
     model->vfs_decay = expf(-cal->control_period_s / cal->vfs_time_constant_s);
+    model->film_damping_m4 = 0.0f;  /* the steady film: the diagnostics measure the paper's model */
     model->cal = cal;
 }
 
@@ -1301,6 +1342,7 @@ int main(void)
         cmocka_unit_test(test_accepted_variants),
         cmocka_unit_test(test_limits_are_inclusive),
         cmocka_unit_test(test_friction_pairs),
+        cmocka_unit_test(test_lock_dwell),
         cmocka_unit_test(test_inner_radius_not_below_outer),
         cmocka_unit_test(test_friction_area_within_the_disc),
         cmocka_unit_test(test_current_max_not_above_min),

@@ -594,10 +594,10 @@ static void test_round_trip_vfs_command(void **state)
     assert_int_equal(wc_can_decode_vfs_command(&out, frame, sizeof frame), WC_CAN_OK);
     assert_float_equal(out.vfs_current_mA, 157.8125f, 0.0f); /* nearest 1/32 */
     assert_float_equal(out.pressure_command_kPa, 363.0f, 0.0f);
-    /* reserved status bits (above WC_CAN_STATUS_BITS: 14, 15) are not sent */
+    /* the reserved status bit (above WC_CAN_STATUS_BITS: 15) is not sent */
     assert_int_equal(out.status, WC_CAN_STATUS_DEFINED_MASK);
-    assert_int_equal(WC_CAN_STATUS_DEFINED_MASK, 0x3FFFu);
-    assert_int_equal(frame[7] & 0xC0u, 0u);
+    assert_int_equal(WC_CAN_STATUS_DEFINED_MASK, 0x7FFFu);
+    assert_int_equal(frame[7] & 0x80u, 0u);
     assert_int_equal(frame[1] & 0xF0u, 0u);
     /* each status bit on its own */
     for (bit = 0u; bit < 16u; ++bit) {
@@ -612,7 +612,8 @@ static void test_round_trip_vfs_command(void **state)
 
 static void test_round_trip_clutch_estimate(void **state)
 {
-    const wc_can_clutch_estimate_phys_t in = {146.93f, -154.66f, 0.0904345f, 4.34249f};
+    const wc_can_clutch_estimate_phys_t in = {146.93f, -154.66f, 0.0904345f, 4.34249f,
+                                               WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_LOCKED_CHOICE};
     wc_can_clutch_estimate_phys_t out;
     uint8_t frame[FRAME_BYTES];
 
@@ -625,6 +626,8 @@ static void test_round_trip_clutch_estimate(void **state)
     assert_float_equal(out.mu_f, in.mu_f, 0.5e-5f + 1e-7f);
     assert_float_equal(out.film_thickness_um, in.film_thickness_um, 0.5e-3f + 1e-6f);
     assert_float_equal(out.model_torque_Nm, -154.7f, 1e-4f);
+    assert_int_equal(out.lock_state, WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_LOCKED_CHOICE);
+    assert_int_equal(frame[1] & 0x10u, 0x10u);  /* LockState: frame bit 12 */
 }
 
 static void test_round_trip_bench_measurement(void **state)
@@ -698,7 +701,7 @@ static void test_short_buffer_is_an_error(void **state)
     uint8_t frame[FRAME_BYTES];
     uint8_t untouched[FRAME_BYTES];
     const wc_can_vfs_command_phys_t cmd = {1.0f, 2.0f, 0u, 0u};
-    const wc_can_clutch_estimate_phys_t est = {1.0f, 2.0f, 0.1f, 3.0f};
+    const wc_can_clutch_estimate_phys_t est = {1.0f, 2.0f, 0.1f, 3.0f, 0u};
     const wc_can_clutch_sensors_phys_t sen = {1.0f, 2.0f, 3.0f, 0u};
     const wc_can_torque_request_phys_t req = {1.0f, 0u, 0u};
     const wc_can_bench_measurement_phys_t bench = {1.0f, 2.0f, 3.0f};

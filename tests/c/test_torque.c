@@ -90,7 +90,7 @@ static long sweep(float slip, float theta, float base_step_N, float end_N, doubl
 {
     wc_torque_t out;
     assert_int_equal(wc_torque(&model, slip, theta, 0.0f, &out), WC_STATUS_OK);
-    const float coulomb_per_N = model.torque_arm_m * out.mu_f;
+    const float coulomb_per_N = (model.effective_radius_m * (float)model.cal->friction_pairs) * out.mu_f;
     float previous = fabsf(out.torque_Nm);
     float force = 0.0f;
     long steps = 0;
@@ -120,7 +120,7 @@ static void test_strictly_increasing_in_force(void **state)
             assert_int_equal(wc_torque(&model, slip, thetas_degC[t], 0.0f, &out), WC_STATUS_OK);
             const float drag = fabsf(out.torque_Nm);
             const float first_step_N =
-                fmaxf(0.01f, 16.0f * (nextafterf(drag, INFINITY) - drag) / (model.torque_arm_m * out.mu_f));
+                fmaxf(0.01f, 16.0f * (nextafterf(drag, INFINITY) - drag) / ((model.effective_radius_m * (float)model.cal->friction_pairs) * out.mu_f));
             checked += sweep(slip, thetas_degC[t], 0.01f, fmaxf(2.0f, 100.0f * first_step_N), slips_rpm[s]);
             checked += sweep(slip, thetas_degC[t], 0.5f, model.force_max_N, slips_rpm[s]);
         }

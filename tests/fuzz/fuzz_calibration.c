@@ -141,8 +141,8 @@ static void evaluate(const wc_calibration_t *c)
     fz_context("wc_model_init(accepted calibration)", 0u);
     FZ_CHECK(wc_model_init(&model, c) == WC_CAL_OK, "wc_model_init rejects what wc_calibration_check accepted");
     FZ_CHECK(fz_finite(model.effective_radius_m) && (model.effective_radius_m > 0.0f) &&
-                 fz_finite(model.torque_arm_m) && (model.torque_arm_m > 0.0f),
-             "R_eff %g, R_eff N_c %g", (double)model.effective_radius_m, (double)model.torque_arm_m);
+                 fz_finite((model.effective_radius_m * (float)model.cal->friction_pairs)) && ((model.effective_radius_m * (float)model.cal->friction_pairs) > 0.0f),
+             "R_eff %g, R_eff N_c %g", (double)model.effective_radius_m, (double)(model.effective_radius_m * (float)model.cal->friction_pairs));
     FZ_CHECK(fz_finite(model.force_max_N) && in_range(model.force_max_N, 0.0f, WC_FORCE_MAX_N),
              "F_max %g outside [0, %g]", (double)model.force_max_N, (double)WC_FORCE_MAX_N);
     FZ_CHECK(fz_finite(model.hbar_at_force_max_m) && (model.hbar_at_force_max_m > 0.0f), "h_bar(F_max) %g",

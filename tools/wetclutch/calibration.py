@@ -68,6 +68,12 @@ PARAMETERS: tuple[tuple[str, str, str, str, str | None], ...] = (
     ("hydraulics", "vfs_current_min", "mA", "nonneg", "vfs_current_min_mA"),
     ("hydraulics", "vfs_current_max", "mA", "pos", "vfs_current_max_mA"),
     ("control", "period", "s", "pos", "control_period_s"),
+    ("engagement", "film_squeeze_factor", "1", "nonneg", "film_squeeze_factor"),
+    ("engagement", "static_friction_factor", "1", "pos", "static_friction_factor"),
+    ("engagement", "lock_slip", "rad/s", "pos", "lock_slip_rad_s"),
+    ("engagement", "breakaway_slip", "rad/s", "pos", "breakaway_slip_rad_s"),
+    ("engagement", "lock_dwell", "1", "count", "lock_dwell_periods"),
+    ("engagement", "holding_margin", "1", "nonneg", "holding_margin"),
     ("film_lut", "nodes", "1", "count", None),
     ("film_lut", "contact_pressure_max", "Pa", "pos", None),
     ("film_lut", "separation_max_sigma", "1", "pos", None),
@@ -107,6 +113,14 @@ LIMITS: dict[str, float] = {
     "FILM_HBAR_MIN_m": 1e-9,                     # h_bar at every node: T_v = ... / h_bar bounded
     "FILM_HBAR_MAX_m": 1e-3,
     "FRITSCH_CARLSON": 9.0,                      # alpha^2 + beta^2 on every interval: monotone Hermite
+    "FILM_SQUEEZE_FACTOR_MIN": 1e-4,             # phi: 0 (film state off) or in [MIN, MAX] (DESIGN 9)
+    "FILM_SQUEEZE_FACTOR_MAX": 1.0,              # phi <= 1: grooves and lining only speed the squeeze up
+    "STATIC_FRICTION_FACTOR_MIN": 0.5,           # static capacity / (mu_f(0, theta) R_eff N_c F_c)
+    "STATIC_FRICTION_FACTOR_MAX": 2.0,
+    "LOCK_SLIP_MAX_rad_s": 10.0,                 # lock band (95 rpm): a lock-up, not a slip controller
+    "BREAKAWAY_SLIP_MAX_rad_s": 20.0,            # breakaway band, above the lock band (hysteresis)
+    "LOCK_DWELL_MAX_periods": 255,               # the firmware counts the dwell in 8 bits
+    "HOLDING_MARGIN_MAX": 1.0,                   # holding force up to twice the request's
 }
 _L = LIMITS
 
@@ -152,6 +166,12 @@ RANGES: dict[str, tuple[float, bool, float | None]] = {
     "vfs_current_max": (0.0, False, _L["CURRENT_MAX_mA"]),   # and > vfs_current_min
     "period": (_L["CONTROL_PERIOD_MIN_s"], True, _L["CONTROL_PERIOD_MAX_s"]),
     "nodes": (2.0, True, FILM_MAX_NODES),
+    "film_squeeze_factor": (0.0, True, _L["FILM_SQUEEZE_FACTOR_MAX"]),   # and 0 or >= the MIN
+    "static_friction_factor": (_L["STATIC_FRICTION_FACTOR_MIN"], True, _L["STATIC_FRICTION_FACTOR_MAX"]),
+    "lock_slip": (0.0, False, _L["LOCK_SLIP_MAX_rad_s"]),
+    "breakaway_slip": (0.0, False, _L["BREAKAWAY_SLIP_MAX_rad_s"]),    # and > lock_slip
+    "lock_dwell": (1.0, True, _L["LOCK_DWELL_MAX_periods"]),
+    "holding_margin": (0.0, True, _L["HOLDING_MARGIN_MAX"]),
 }
 
 
@@ -353,6 +373,16 @@ def _check_relations(cal: Calibration) -> None:
                 f"{p}: parameters 'thermal.oil_conductance', 'thermal.housing_conductance', the heat capacity of"
                 f" the thermal section and 'control.period' ({C_NAMES['time_constant']}): the thermal time"
                 f" constant {float(tc):.6g} s must be in [control.period, {_L['TIME_CONSTANT_MAX_s']:g}] s")
+        # engagement edges (DESIGN 9): the film state off (0) or a squeeze factor the update resolves;
+        # breakaway outside the lock band (hysteresis)
+        phi = c["film_squeeze_factor"]
+        if not (phi == 0 or phi >= F(_L["FILM_SQUEEZE_FACTOR_MIN"])):
+            raise CalibrationError(
+                f"{p}: parameter 'engagement.film_squeeze_factor' (film_squeeze_factor) must be 0 (film state off)"
+                f" or in [{_L['FILM_SQUEEZE_FACTOR_MIN']:g}, {_L['FILM_SQUEEZE_FACTOR_MAX']:g}]")
+        if not c["breakaway_slip"] > c["lock_slip"]:
+            raise CalibrationError(f"{p}: parameter 'engagement.breakaway_slip' (breakaway_slip_rad_s) must be >"
+                                   " engagement.lock_slip (the hysteresis between locking and breakaway)")
         # the film table reaches the contact pressure at the maximum current
         pressure = force / c["friction_area"]
         if not F(v["contact_pressure_max"]) >= pressure:

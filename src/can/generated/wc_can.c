@@ -345,6 +345,7 @@ int wc_can_vfs_command_pack(
     dst_p[7] |= pack_left_shift_u8(src_p->status_bench_input, 3u, 0x08u);
     dst_p[7] |= pack_left_shift_u8(src_p->status_frame_lost, 4u, 0x10u);
     dst_p[7] |= pack_left_shift_u8(src_p->status_bus_error, 5u, 0x20u);
+    dst_p[7] |= pack_left_shift_u8(src_p->status_locked, 6u, 0x40u);
 
     return (8);
 }
@@ -378,6 +379,7 @@ int wc_can_vfs_command_unpack(
     dst_p->status_bench_input = unpack_right_shift_u8(src_p[7], 3u, 0x08u);
     dst_p->status_frame_lost = unpack_right_shift_u8(src_p[7], 4u, 0x10u);
     dst_p->status_bus_error = unpack_right_shift_u8(src_p[7], 5u, 0x20u);
+    dst_p->status_locked = unpack_right_shift_u8(src_p[7], 6u, 0x40u);
 
     return (0);
 }
@@ -573,6 +575,16 @@ bool wc_can_vfs_command_status_bus_error_is_in_phys_range(float value)
     return ((value >= 0.0f) && (value <= 1.0f));
 }
 
+bool wc_can_vfs_command_status_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_vfs_command_status_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
 int wc_can_clutch_estimate_pack(
     uint8_t *dst_p,
     const struct wc_can_clutch_estimate_t *src_p,
@@ -588,6 +600,7 @@ int wc_can_clutch_estimate_pack(
 
     dst_p[0] |= pack_left_shift_u16(src_p->estimated_clutch_temp, 0u, 0xffu);
     dst_p[1] |= pack_right_shift_u16(src_p->estimated_clutch_temp, 8u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->lock_state, 4u, 0x10u);
     model_torque = (uint16_t)src_p->model_torque;
     dst_p[2] |= pack_left_shift_u16(model_torque, 0u, 0xffu);
     dst_p[3] |= pack_right_shift_u16(model_torque, 8u, 0xffu);
@@ -612,6 +625,7 @@ int wc_can_clutch_estimate_unpack(
 
     dst_p->estimated_clutch_temp = unpack_right_shift_u16(src_p[0], 0u, 0xffu);
     dst_p->estimated_clutch_temp |= unpack_left_shift_u16(src_p[1], 8u, 0x0fu);
+    dst_p->lock_state = unpack_right_shift_u8(src_p[1], 4u, 0x10u);
     model_torque = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
     model_torque |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
     dst_p->model_torque = (int16_t)model_torque;
@@ -640,6 +654,16 @@ bool wc_can_clutch_estimate_estimated_clutch_temp_is_in_range(uint16_t value)
 bool wc_can_clutch_estimate_estimated_clutch_temp_is_in_phys_range(float value)
 {
     return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+bool wc_can_clutch_estimate_lock_state_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_clutch_estimate_lock_state_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
 }
 
 bool wc_can_clutch_estimate_model_torque_is_in_range(int16_t value)

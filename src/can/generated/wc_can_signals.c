@@ -184,7 +184,7 @@ wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command
     if (wc_can_vfs_command_pack(dst, &msg, size) < 0) {
         return WC_CAN_ERR_SIZE;
     }
-    const uint32_t status_bits = ((uint32_t)src->status & 0x3FFFu) << 0;  /* frame bits 48..61 */
+    const uint32_t status_bits = ((uint32_t)src->status & 0x7FFFu) << 0;  /* frame bits 48..62 */
     dst[6] = (uint8_t)(dst[6] | (uint8_t)(status_bits >> 0));
     dst[7] = (uint8_t)(dst[7] | (uint8_t)(status_bits >> 8));
     (void)wc_e2e_protect(WC_CAN_VFS_COMMAND_FRAME_ID, dst, size);
@@ -210,7 +210,7 @@ wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const 
     dst->pressure_command_kPa = to_phys(&wc_can_sig_vfs_command_pressure_command, msg.pressure_command, &result);
     status |= (uint32_t)src[6] << 0;
     status |= (uint32_t)src[7] << 8;
-    dst->status = (uint16_t)((status >> 0) & 0x3FFFu);  /* frame bits 48..61 */
+    dst->status = (uint16_t)((status >> 0) & 0x7FFFu);  /* frame bits 48..62 */
     dst->alive_counter = msg.alive_counter;
     return result;
 }
@@ -229,6 +229,8 @@ wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_
     msg.model_torque = (int16_t)to_raw(&wc_can_sig_clutch_estimate_model_torque, src->model_torque_Nm, &result);
     msg.mu_f = (uint16_t)to_raw(&wc_can_sig_clutch_estimate_mu_f, src->mu_f, &result);
     msg.film_thickness = (uint16_t)to_raw(&wc_can_sig_clutch_estimate_film_thickness, src->film_thickness_um, &result);
+    msg.lock_state = (uint8_t)(src->lock_state & 0x01u);
+    if (src->lock_state > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
     if (wc_can_clutch_estimate_pack(dst, &msg, size) < 0) {
         return WC_CAN_ERR_SIZE;
     }
@@ -250,6 +252,10 @@ wc_can_result_t wc_can_decode_clutch_estimate(wc_can_clutch_estimate_phys_t *dst
     dst->model_torque_Nm = to_phys(&wc_can_sig_clutch_estimate_model_torque, msg.model_torque, &result);
     dst->mu_f = to_phys(&wc_can_sig_clutch_estimate_mu_f, msg.mu_f, &result);
     dst->film_thickness_um = to_phys(&wc_can_sig_clutch_estimate_film_thickness, msg.film_thickness, &result);
+    dst->lock_state = msg.lock_state;
+    if (!wc_can_clutch_estimate_lock_state_is_in_range(msg.lock_state)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
     return result;
 }
 
