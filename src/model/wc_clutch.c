@@ -100,23 +100,28 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     /* valid: the modelled force is in [0, F_max] (F_max <= WC_FORCE_MAX_N by the
      * calibration check), the bench force was range-checked above */
     const wc_calibration_t *cal = model->cal;
+    /* Inside the lock band the slip's sign is sensor noise: the torque keeps
+     * the direction of the slip before it (DESIGN 9), so the estimate does not
+     * flip sign with every noisy sample before the lock. */
+    const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
+    const float signed_slip_rad_s = (fabsf(u->slip_rad_s) < cal->lock_slip_rad_s) ? direction : u->slip_rad_s;
+    /* (the torque takes only its sign from it: the speed is the point's) */
     if (model->film_damping_m4 > 0.0f) {
         /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
          * squeeze film carries the rest, and the film advances under the force. */
         const float hbar_m = clutch->film_hbar_m;
         const float contact_N = cal->friction_area_m2 * wc_film_pressure_Pa(&cal->film, hbar_m);
-        wc_torque_at_film(&point, u->slip_rad_s, contact_N, hbar_m, &out->model);
+        wc_torque_at_film(&point, signed_slip_rad_s, contact_N, hbar_m, &out->model);
         out->contact_force_N = contact_N;
         clutch->film_hbar_m = wc_film_advance_m(&cal->film, cal->friction_area_m2, hbar_m, force_N,
                                                 model->film_damping_m4 * point.viscosity_Pa_s, cal->control_period_s);
     } else {
-        wc_torque_at_point(model, &point, u->slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
+        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
         out->contact_force_N = force_N;
     }
 
     /* DESIGN 9: lock-up against the static capacity at the contact force. */
     out->static_capacity_Nm = point.static_Nm_per_N * out->contact_force_N;
-    const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
     const float required_Nm = bench_torque ? in->bench.torque_Nm : direction * u->torque_request_Nm;
     const bool locked = wc_lockup_update(&clutch->lockup, cal, u->slip_rad_s, required_Nm, out->static_capacity_Nm);
     if (locked) {

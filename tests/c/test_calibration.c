@@ -1028,7 +1028,19 @@ static void sweep_clutch(sweep_t *s, wc_clutch_t *clutch)
                  "wc_clutch_step theta %g", (double)out.theta_degC);
         PHYSICAL(s, (clutch->theta_degC >= WC_THETA_MIN_degC) && (clutch->theta_degC <= WC_THETA_MAX_degC),
                  "wc_clutch_step state theta %g", (double)clutch->theta_degC);
-        check_torque_out(s, &out.model, clutch->held.slip_rad_s, "wc_clutch_step");
+        /* Inside the lock band the torque keeps the lock direction (DESIGN 9); locked, it is the held
+         * torque, within the static capacity. */
+        const float slip = clutch->held.slip_rad_s;
+        const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
+        const float sign_slip = (fabsf(slip) < cal->lock_slip_rad_s) ? direction * fmaxf(fabsf(slip), FLT_MIN) : slip;
+        check_torque_out(s, &out.model, sign_slip, "wc_clutch_step");
+        PHYSICAL(s, isfinite(out.static_capacity_Nm) && (out.static_capacity_Nm >= 0.0f),
+                 "wc_clutch_step static capacity %g", (double)out.static_capacity_Nm);
+        if ((out.status & WC_STATUS_LOCKED) != 0u) {
+            PHYSICAL(s, fabsf(out.model.torque_Nm) <= out.static_capacity_Nm,
+                     "wc_clutch_step locked torque %g above the capacity %g", (double)out.model.torque_Nm,
+                     (double)out.static_capacity_Nm);
+        }
     }
 }
 

@@ -33,6 +33,9 @@ def assert_frames_match_reference(ref: dict, frames: dict, steps: int | None = N
         excess = np.abs(got - want) - (half * 1.0001 + 1e-4 * np.abs(want))
         k = int(np.argmax(excess))
         assert excess[k] <= 0.0, f"{name}: worst at step {k}: {got[k]} vs {want[k]}"
+    # The lock-up state (DESIGN 9) in both frames.
+    locked = (ref["status_bits"] & replay.BIT["StatusLocked"]) != 0
+    assert np.array_equal(est["LockState"] == 1, locked), "LockState differs from the reference's lock-up"
     # Every status bit as the documented policy and the model say.
     mismatch = np.flatnonzero((cmd["status"] & ~replay.BIT["StatusDeadlineMiss"]) != ref["status_bits"])
     assert mismatch.size == 0, f"status differs at steps {mismatch[:10]}"

@@ -28,6 +28,7 @@ STATUS_TORQUE_INVALID = 1 << 6    # torque request NaN, infinite, negative or to
 STATUS_POWER_INVALID = 1 << 7     # heat input NaN, infinite or negative
 STATUS_OVER_TEMPERATURE = 1 << 8  # estimate above THETA_OVER_DEGC (hysteresis THETA_OVER_HYSTERESIS_K)
 STATUS_NOT_INITIALISED = 1 << 9   # NULL or uninitialised instance (C only)
+STATUS_LOCKED = 1 << 10           # clutch locked: static friction holds it (DESIGN 9); not an error
 # Thermal envelope (include/wetclutch/wc_config.h, DESIGN section 8).
 THETA_MIN_DEGC, THETA_MAX_DEGC = -40.0, 250.0
 THETA_OVER_DEGC, THETA_OVER_HYSTERESIS_K = 200.0, 10.0
@@ -151,8 +152,109 @@ class FilmTable:
         return np.interp(self._clamped(pressure_Pa), self.pressure_Pa, self.hbar_m)
 
 
-def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N):
+# --------------------------------------------------------------------------- engagement edges (DESIGN 9)
+
+def reynolds_factor_m4(cal: Calibration) -> float:
+    """K = Ro^4 - Ri^4 - (Ro^2 - Ri^2)^2 / ln(Ro/Ri): Reynolds' squeeze film between annular plates."""
+    ro, ri = cal.outer_radius, cal.inner_radius
+    return ro**4 - ri**4 - (ro**2 - ri**2) ** 2 / math.log(ro / ri)
+
+
+def film_damping_N_s_m2(cal: Calibration, theta_degC, squeeze_factor: float | None = None):
+    """D = 3 pi phi mu_v(theta) K / 2: F_h = D (-dh_bar/dt) / h_bar^3 (DESIGN 9)."""
+    phi = cal.film_squeeze_factor if squeeze_factor is None else squeeze_factor
+    return 1.5 * math.pi * phi * reynolds_factor_m4(cal) * viscosity_Pa_s(cal, theta_degC)
+
+
+def separation_from_hbar_m(cal: Calibration, hbar_m):
+    """Inverse of eq. 9 by vectorized bisection (h_bar strictly increases with h)."""
+    hb = np.asarray(hbar_m, dtype=float)
+    s = cal.roughness_rms
+    lo = np.full(hb.shape, -60.0 * s)
+    hi = np.full(hb.shape, np.maximum(60.0 * s, 2.0 * hb))
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        below = film_thickness_m(cal, mid) < hb
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def film_contact_pressure_Pa(cal: Calibration, hbar_m):
+    """(p_c, dp_c/dh_bar) of the asperities at film h_bar (eq. 9, 15), on the film domain: 0 at or above the
+    open-clutch film, the domain's last pressure at or below its thinnest film (wc_film_pressure_Pa)."""
+    h_min, h_max, _, p_max = film_domain(cal)
+    hb = np.asarray(hbar_m, dtype=float)
+    h = np.clip(separation_from_hbar_m(cal, hb), h_min, h_max)
+    x = h / (math.sqrt(2.0) * cal.roughness_rms)
+    enb = cal.youngs_modulus * cal.asperity_density * cal.asperity_tip_radius
+    slope = -(math.pi / 2.0) * enb * erfc(x) / (0.5 * (1.0 + erf(x)))       # (dp_c/dh) / (dh_bar/dh)
+    p = np.where(hb >= film_thickness_m(cal, h_max), 0.0, contact_pressure_Pa(cal, h))
+    return p, slope
+
+
+def film_advance_m(cal: Calibration, hbar_m: float, apply_force_N: float, theta_degC: float,
+                   squeeze_factor: float | None = None, dt_s: float | None = None) -> float:
+    """One control period of the squeeze film, the firmware's scheme (wc_film_advance_m) in double with the
+    exact eq. 9/15 (no table) and the exact dp_c/dh_bar where the firmware takes its table's secant: in
+    u = 1/h_bar^2, D du/dt = 2 (F_app - F_c), linearly implicit in F_c, never past the settled film."""
+    dt = cal.period if dt_s is None else dt_s
+    area = cal.friction_area
+    settled = float(hbar_from_pressure_m(cal, apply_force_N / area))
+    p, slope = film_contact_pressure_Pa(cal, hbar_m)
+    squeeze = apply_force_N - area * float(p)
+    damping = float(film_damping_N_s_m2(cal, theta_degC, squeeze_factor))
+    u = 1.0 / hbar_m**2
+    u_next = u + 2.0 * dt * squeeze / (damping - dt * area * float(slope) * hbar_m**3)
+    u_settled = 1.0 / settled**2
+    closing = u_settled > u
+    if not (u_next < u_settled if closing else u_next > u_settled):
+        return settled
+    return 1.0 / math.sqrt(u_next) if (u_next > u if closing else u_next < u) else hbar_m
+
+
+def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
+    """Static capacity: static factor mu_f(0, theta) R_eff N_c F_c (DESIGN 9; eq. 18 at v = 0)."""
+    return (cal.static_friction_factor * friction_coefficient(cal, 0.0, theta_degC)
+            * cal.effective_radius * cal.friction_pairs * np.asarray(contact_force_N, dtype=float))
+
+
+class Lockup:
+    """The firmware's lock-up state machine (wc_lockup.c): slipping <-> locked (DESIGN 9)."""
+
+    def __init__(self, cal: Calibration):
+        self.cal = cal
+        self.locked = False
+        self.direction = 1.0
+        self.dwell = 0
+
+    def update(self, slip_rad_s: float, required_Nm: float, capacity_Nm: float) -> bool:
+        cal = self.cal
+        holds = abs(required_Nm) < capacity_Nm
+        if self.locked:
+            if not (abs(slip_rad_s) <= cal.breakaway_slip) or not holds:
+                self.locked, self.dwell = False, 0
+            return self.locked
+        if abs(slip_rad_s) < cal.lock_slip and holds:
+            self.dwell = min(self.dwell + 1, 255)
+            self.locked = self.dwell >= cal.lock_dwell
+        else:
+            self.dwell = 0
+            if abs(slip_rad_s) >= cal.lock_slip:
+                self.direction = -1.0 if slip_rad_s < 0.0 else 1.0
+        return self.locked
+
+    def torque_Nm(self, required_Nm: float, capacity_Nm: float) -> float:
+        """What a locked clutch transmits: the required torque in the lock direction, at most the capacity."""
+        along = self.direction * required_Nm
+        return self.direction * (min(along, capacity_Nm) if along > 0.0 else 0.0)
+
+
+def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None):
     """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
+
+    hbar_m: the film the contact force stands on; default the steady film of eq. 16 (the squeeze-film
+    state of DESIGN 9 passes its own).
 
     Torques carry the sign of the slip speed (slip >= 0 counts as positive):
     the torque transmitted through the slipping clutch, which acts against
@@ -165,7 +267,8 @@ def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N):
     sign = np.where(slip < 0.0, -1.0, 1.0)
     speed = cal.effective_radius * np.abs(slip) * RAD_S_PER_RPM          # eq. 4
     mu_f = friction_coefficient(cal, speed, theta)                       # eq. 18
-    hbar = hbar_from_pressure_m(cal, force / cal.friction_area)           # eq. 9, 15, 16
+    hbar = (hbar_from_pressure_m(cal, force / cal.friction_area)          # eq. 9, 15, 16
+            if hbar_m is None else np.asarray(hbar_m, dtype=float))
     rn = cal.effective_radius * cal.friction_pairs
     coulomb = rn * mu_f * force                                          # eq. 6
     viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / hbar  # eq. 7
@@ -279,19 +382,37 @@ def thermal_observer(cal: Calibration, slip_rpm, torque_Nm, theta_oil_degC, thet
 MODE_OPEN, MODE_TORQUE, MODE_LOCKED = 0, 1, 2
 
 
+def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float) -> dict:
+    """The inverse for a locked clutch (DESIGN 9): the force whose static capacity holds the request with the
+    holding margin, at most the force at the maximum current (STATUS_SATURATED)."""
+    per_N = float(static_capacity_Nm(cal, theta_degC, 1.0))
+    force = torque_Nm * (1.0 + cal.holding_margin) / per_N
+    status = 0
+    if force > force_max_N(cal):
+        force, status = force_max_N(cal), STATUS_SATURATED
+    pressure = (force + cal.return_spring_force) / cal.piston_area
+    current = pressure / cal.vfs_gain
+    if current < cal.vfs_current_min or current > cal.vfs_current_max:
+        status |= STATUS_CURRENT_CLAMPED
+    return {"force_N": force, "pressure_Pa": pressure, "current_mA": min(max(current, cal.vfs_current_min),
+                                                                           cal.vfs_current_max), "status": status}
+
+
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
                  mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None):
     """The firmware's wc_clutch_step, composed in double precision, one row per period.
 
-    Per step k: inverse at theta[k] (or the solenoid's minimum/maximum current
-    for the open/locked modes) -> current; VFS lag (exact, tau) -> reached
-    pressure -> contact force F = max(P A_p - F_s, 0) -> model torque;
-    observer advanced with |T dw| and kept in [THETA_MIN_DEGC, THETA_MAX_DEGC],
-    STATUS_OVER_TEMPERATURE above THETA_OVER_DEGC until it falls THETA_OVER_HYSTERESIS_K
-    below (wc_clutch_step). Returns a dict of arrays; theta_degC[k] is
-    the estimate used in step k (before its update). On a bench (rows where
-    bench_force_N / bench_torque_Nm are given and not NaN) the torque model
-    uses the measured force and the observer's heat input the measured torque.
+    Per step k: inverse at theta[k] (a locked clutch: holding_inverse; the open/locked modes: the solenoid's
+    minimum/maximum current) -> current; VFS lag (exact, tau) -> reached pressure -> apply force
+    F = max(P A_p - F_s, 0) -> contact force (F, or with the squeeze-film state on, DESIGN 9, the asperity
+    force at the film state, which then advances under F: film_advance_m) -> model torque; lock-up (Lockup)
+    against the static capacity with the required torque (the measured torque on a bench, else the request in
+    the lock direction); while locked the held torque (Lockup.torque_Nm), no heat and STATUS_LOCKED;
+    observer advanced with |T dw| and kept in [THETA_MIN_DEGC, THETA_MAX_DEGC], STATUS_OVER_TEMPERATURE above
+    THETA_OVER_DEGC until it falls THETA_OVER_HYSTERESIS_K below (wc_clutch_step). Returns a dict of arrays;
+    theta_degC[k] is the estimate used in step k (before its update). On a bench (rows where
+    bench_force_N / bench_torque_Nm are given and not NaN) the torque model uses the measured force and the
+    observer's heat input the measured torque.
     """
     slip = np.asarray(slip_rpm, dtype=float)
     n = slip.size
@@ -306,14 +427,19 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     a_vfs = math.exp(-cal.period / cal.vfs_time_constant)
     theta = float(oil[0]) if theta_start_degC is None else float(theta_start_degC)
     pressure = cal.vfs_gain * cal.vfs_current_min
+    film_on = cal.film_squeeze_factor > 0.0
+    hbar = float(hbar_from_pressure_m(cal, max(pressure * cal.piston_area - cal.return_spring_force, 0.0)
+                                      / cal.friction_area))
+    lockup = Lockup(cal)
     over = False
     names = ("current_mA", "pressure_command_Pa", "pressure_model_Pa", "force_command_N", "theta_degC",
-             "torque_Nm", "mu_f", "hbar_m", "status")
+             "torque_Nm", "mu_f", "hbar_m", "contact_force_N", "static_capacity_Nm", "status")
     out = {k: np.empty(n) for k in names}
     for k in range(n):
         out["theta_degC"][k] = theta
         if modes[k] == MODE_TORQUE:
-            inv = inverse(cal, slip[k], theta, request[k])
+            inv = (holding_inverse(cal, theta, request[k]) if lockup.locked
+                   else inverse(cal, slip[k], theta, request[k]))
             current, force_cmd, status = float(inv["current_mA"]), float(inv["force_N"]), int(inv["status"])
         else:
             current = cal.vfs_current_max if modes[k] == MODE_LOCKED else cal.vfs_current_min
@@ -324,10 +450,26 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
         force = max(pressure * cal.piston_area - cal.return_spring_force, 0.0)
         if not math.isnan(measured[k]):
             force = measured[k]
-        parts = torque_parts(cal, slip[k], theta, force)
-        torque = float(parts["torque_Nm"])
-        heat_torque = torque if math.isnan(measured_torque[k]) else measured_torque[k]
-        power = abs(heat_torque * slip[k] * RAD_S_PER_RPM)
+        # inside the lock band the torque keeps the lock direction (the slip's sign there is noise)
+        in_band = abs(slip[k]) * RAD_S_PER_RPM < cal.lock_slip
+        if film_on:
+            contact = cal.friction_area * float(film_contact_pressure_Pa(cal, hbar)[0])
+            parts = torque_parts(cal, abs(slip[k]), theta, contact, hbar_m=hbar)
+            hbar = film_advance_m(cal, hbar, force, theta)
+        else:
+            contact = force
+            parts = torque_parts(cal, abs(slip[k]), theta, force)
+        torque = float(parts["torque_Nm"]) * (lockup.direction if in_band else (-1.0 if slip[k] < 0.0 else 1.0))
+        capacity = float(static_capacity_Nm(cal, theta, contact))
+        bench_torque = not math.isnan(measured_torque[k])
+        required = measured_torque[k] if bench_torque else lockup.direction * request[k]
+        slip_rad_s = slip[k] * RAD_S_PER_RPM
+        if lockup.update(slip_rad_s, required, capacity):
+            torque = lockup.torque_Nm(required, capacity)
+            status |= STATUS_LOCKED
+            power = 0.0
+        else:
+            power = abs((measured_torque[k] if bench_torque else torque) * slip_rad_s)
         steady = float(thermal_steady_degC(cal, power, oil[k], housing[k]))
         theta = steady + (theta - steady) * a_th
         theta = min(max(theta, THETA_MIN_DEGC), THETA_MAX_DEGC)      # thermal envelope
@@ -339,7 +481,8 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
             status |= STATUS_OVER_TEMPERATURE
         for key, value in (("current_mA", current), ("pressure_command_Pa", target), ("pressure_model_Pa", pressure),
                            ("force_command_N", force_cmd), ("torque_Nm", torque), ("mu_f", float(parts["mu_f"])),
-                           ("hbar_m", float(parts["hbar_m"])), ("status", status)):
+                           ("hbar_m", float(parts["hbar_m"])), ("contact_force_N", contact),
+                           ("static_capacity_Nm", capacity), ("status", status)):
             out[key][k] = value
     out["status"] = out["status"].astype(int)
     return out

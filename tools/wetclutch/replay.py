@@ -262,6 +262,7 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
     bits |= np.where(status & model.STATUS_CURRENT_CLAMPED, BIT["StatusCurrentClamped"], 0)
     bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
     bits |= np.where(status & model.STATUS_OVER_TEMPERATURE, BIT["StatusOverTemperature"], 0)
+    bits |= np.where(status & model.STATUS_LOCKED, BIT["StatusLocked"], 0)
     return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
             "bench_force_N": load, "bench_torque_Nm": measured_torque,
             "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
