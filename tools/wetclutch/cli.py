@@ -134,12 +134,18 @@ def _cmd_bench(args) -> int:
     from . import bench  # the simulator only when needed
     start = time.monotonic()
     out = bench.run(args.experiment, args.out, true_path=args.true, seed=args.seed, slips_rpm=args.slip,
-                    logs=True if args.logs else None)
+                    logs=True if args.logs else None, thetas_degC=args.theta)
     for r in out["results"]:
         if r.experiment.kind == "engagement":
             f = bench.engagement_figures(r)
             print(f"{r.experiment.name}: contact {f['t_contact_s']:.3f} s, lock {f['t_lock_s']:.3f} s,"
-                  f" peak torque {f['peak_torque_Nm']:.1f} Nm, peak viscous {f['peak_viscous_Nm']:.1f} Nm")
+                  f" peak torque {f['peak_torque_Nm']:.1f} Nm, peak viscous {f['peak_viscous_Nm']:.1f} Nm,"
+                  f" 90 % contact force {f['film_90_s']:.3f} s after contact")
+        elif r.experiment.kind == "breakaway":
+            f = bench.breakaway_figures(r)
+            print(f"{r.experiment.name}: breakaway {f['t_breakaway_s']:.3f} s at {f['static_capacity_Nm']:.1f} Nm"
+                  f" (measured peak while locked {f['breakaway_torque_measured_Nm']:.1f} Nm), motor off"
+                  f" {f['t_motor_off_s']:.3f} s, locked again {f['t_relock_s']:.3f} s")
     print(f"wrote {len(out['files'])} files to {args.out} ({len(out['results'])} experiment(s), seed {args.seed},"
           f" true parameters {args.true}) in {time.monotonic() - start:.1f} s")
     return 0
@@ -216,16 +222,21 @@ def build_parser() -> argparse.ArgumentParser:
     q.set_defaults(func=_cmd_identify)
 
     q = sub.add_parser("bench", help="simulate the test bench (DESIGN 7): measurement CSVs and CAN logs")
-    q.add_argument("experiment", choices=("engagement", "table2", "thermal"),
-                   help="engagement (Fig. 15), table2 (the 184-experiment campaign), thermal (Fig. 13)")
+    q.add_argument("experiment", choices=("engagement", "table2", "thermal", "breakaway"),
+                   help="engagement (Fig. 15), table2 (the 184-experiment campaign), thermal (Fig. 13),"
+                        " breakaway (static capacity: a torque ramp on the locked clutch)")
     q.add_argument("--out", required=True, help="output directory")
     q.add_argument("--true", default="tools/calibrations/bench_true.toml",
                    help="the bench's true parameters (calibration TOML; default tools/calibrations/bench_true.toml)")
     q.add_argument("--seed", default="1", help="noise seed, a whole number >= 0 (default 1)")
     q.add_argument("--slip", type=float, action="append", metavar="RPM",
                    help="engagement initial slip, repeatable (default 750, 500 and 250 rpm)")
+    q.add_argument("--theta", type=float, action="append", metavar="DEGC",
+                   help="engagement/breakaway initial temperature (clutch, oil, housing), repeatable"
+                        " (default 40 and 80 degC)")
     q.add_argument("--logs", action="store_true",
-                   help="table2/thermal: also write the 1 ms CAN logs (and 1 ms CSVs); slow and large")
+                   help="table2/thermal/breakaway: also write the 1 ms CAN logs (and 1 ms CSVs for table2/thermal);"
+                        " slow and large for table2/thermal")
     q.set_defaults(func=_cmd_bench)
 
     q = sub.add_parser("convert", help="convert a Vector ASC/BLF log to candump -L (for canplayer)")
