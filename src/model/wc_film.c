@@ -83,7 +83,8 @@ static float film_pressure_Pa(const wc_film_table_t *table, float hbar_m, float 
         if (residual_m > 0.0f) { t_lo = t; } else { t_hi = t; }  /* h_bar(t) falls with t */
         const float derivative_m = m0 + t * (2.0f * c2 + 3.0f * t * c3);
         const float newton = (derivative_m < 0.0f) ? t - residual_m / derivative_m : -1.0f;
-        t = ((newton > t_lo) && (newton < t_hi)) ? newton : 0.5f * (t_lo + t_hi);
+        /* inclusive: a converged step lands on t, which is now a bracket end */
+        t = ((newton >= t_lo) && (newton <= t_hi)) ? newton : 0.5f * (t_lo + t_hi);
     }
     return p[lo] + t * width_Pa;
 }

@@ -377,6 +377,60 @@ static void test_thermal_envelope_matches_golden(void **state)
     WC_CHECK((clutch.over_temperature == false), "still over-temperature after cooling");
 }
 
+/* Engagement edges (DESIGN 9) against the double-precision reference (tests/vectors: wc_golden_edges,
+ * vectors.edges_profile): table1 with the squeeze-film state on, contact, lock, breakaway by torque, lock,
+ * breakaway by slip, every step. Tolerances: the current 2e-3 relative + 0.05 mA; torque, film, contact
+ * force and capacity 1e-3 (+ 0.05 Nm, 0.5 N) (float against double,
+ * the film table against eq. 9/15 (1e-4), the Newton inverse of the table and the table's secant where the
+ * reference takes the exact slope in the film's implicit step); the lock decisions compare a slowly rising
+ * capacity with the request, so float may cross a threshold one step from double: the lock state must match
+ * except within 2 steps of a reference transition, and the same four transitions must happen. */
+static void test_engagement_edges_match_golden(void **state)
+{
+    (void)state;
+    wc_calibration_t cal = wc_table1_calibration;
+    cal.film_squeeze_factor = 0.1f;       /* vectors.EDGES_SQUEEZE_FACTOR */
+    cal.static_friction_factor = 1.1f;    /* vectors.EDGES_STATIC_FACTOR */
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, &cal, 40.0f), WC_CAL_OK);
+    const size_t rows = WC_TEST_COUNT(wc_golden_edges);
+    int transitions = 0;
+    bool was_locked = false;
+    for (size_t k = 0u; k < rows; ++k) {
+        const wc_golden_edges_t *g = &wc_golden_edges[k];
+        wc_step_input_t in;
+        memset(&in, 0, sizeof in);
+        in.slip_rad_s = wc_test_rpm_to_rad_s(g->slip_rpm);
+        in.theta_oil_degC = 40.0f;
+        in.theta_housing_degC = 40.0f;
+        in.torque_request_Nm = (float)g->torque_request_Nm;
+        in.mode = (k < 100u) ? WC_MODE_OPEN : WC_MODE_TORQUE;  /* open for the first 0.1 s */
+        wc_step_output_t out;
+        const wc_status_t status = wc_clutch_step(&clutch, &in, &out);
+        const bool locked = (status & WC_STATUS_LOCKED) != 0u;
+        const bool ref_locked = (g->status & (int)WC_STATUS_LOCKED) != 0;
+        bool near_transition = false;
+        for (size_t j = (k > 2u) ? k - 2u : 1u; (j <= k + 2u) && (j < rows); ++j) {
+            near_transition |= ((wc_golden_edges[j].status ^ wc_golden_edges[j - 1u].status) & (int)WC_STATUS_LOCKED) != 0;
+        }
+        transitions += (locked != was_locked) ? 1 : 0;
+        was_locked = locked;
+        if (near_transition) { continue; }
+        WC_CHECK(locked == ref_locked, "step %zu: locked %d, reference %d", k, (int)locked, (int)ref_locked);
+        WC_CHECK_CLOSE("current_mA", (long)k, out.current_mA, g->current_mA, 2e-3, 0.05);
+        WC_CHECK_CLOSE("torque_Nm", (long)k, out.model.torque_Nm, g->torque_Nm, 1e-3, 0.05);
+        WC_CHECK_CLOSE("hbar_um", (long)k, out.model.hbar_m * 1e6f, g->hbar_um, 1e-3, 1e-3);
+        WC_CHECK_CLOSE("contact_force_N", (long)k, out.contact_force_N, g->contact_force_N, 1e-3, 0.5);
+        WC_CHECK_CLOSE("static_capacity_Nm", (long)k, out.static_capacity_Nm, g->static_capacity_Nm, 1e-3, 0.05); /* ~ F_c */
+        if (locked) {
+            WC_CHECK(fabsf(out.model.torque_Nm) <= out.static_capacity_Nm, "step %zu: locked torque %g above %g", k,
+                     (double)out.model.torque_Nm, (double)out.static_capacity_Nm);
+        }
+    }
+    assert_int_equal(transitions, 4);  /* lock, breakaway (torque), lock, breakaway (slip) */
+    assert_true(clutch.lockup.direction < 0);  /* after the slip reversed */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -387,6 +441,7 @@ int main(void)
         cmocka_unit_test(test_closed_loop_reaches_request),
         cmocka_unit_test(test_two_instances_do_not_interfere),
         cmocka_unit_test(test_thermal_envelope_matches_golden),
+        cmocka_unit_test(test_engagement_edges_match_golden),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -237,6 +237,128 @@ static void test_segment_cubic_is_the_interpolant(void **state)
     printf("    segment cubic vs wc_film_hbar_m: max relative difference %.3g (allowed 1e-5)\n", worst);
 }
 
+/* ---- Squeeze film (DESIGN 9) -------------------------------------------- */
+
+/* wc_film_pressure_Pa inverts wc_film_hbar_m: on a dense grid of pressures over the table,
+ * p(h_bar(p)) = p within 2e-5 relative (float rounding of h_bar, 6e-8, times |d ln p / d ln h_bar| <= ~10
+ * at the open end, plus Newton's 3 steps), and 0 at and above the open film, the last node at the thinnest. */
+static void test_pressure_inverts_hbar(void **state)
+{
+    (void)state;
+    const wc_film_table_t *t = table1();
+    double worst = 0.0;
+    for (int i = 1; i < 4000; ++i) {
+        const float p = t->pressure_Pa[0] + (t->pressure_Pa[t->length - 1u] - t->pressure_Pa[0]) * (float)i / 4000.0f;
+        if (p < 1000.0f) { continue; }  /* the open end: p_c of a few Pa, 1e-6 N of force */
+        const float back = wc_film_pressure_Pa(t, wc_film_hbar_m(t, p));
+        const double rel = fabs((double)back / (double)p - 1.0);
+        worst = (rel > worst) ? rel : worst;
+    }
+    printf("    wc_film_pressure_Pa(wc_film_hbar_m(p)): max relative error %.3g (allowed 2e-5)\n", worst);
+    WC_CHECK(worst <= 2e-5, "inverse error %g", worst);
+    assert_true(wc_test_same_float(wc_film_pressure_Pa(t, t->hbar_m[0]), 0.0f));
+    assert_true(wc_test_same_float(wc_film_pressure_Pa(t, 1.0f), 0.0f));
+    assert_true(wc_test_same_float(wc_film_pressure_Pa(t, NAN), 0.0f));
+    assert_true(wc_test_same_float(wc_film_pressure_Pa(t, 0.0f), t->pressure_Pa[t->length - 1u]));
+}
+
+/* The model's squeeze-film damping per unit viscosity, 3 pi phi K / 2 in float, against K in double:
+ * K = Ro^4 - Ri^4 - (Ro^2 - Ri^2)^2 / ln(Ro/Ri) cancels by 1/140 for Table 1's pack, 1e-4 covers the float
+ * form (wc_model.c). */
+static void test_reynolds_factor(void **state)
+{
+    (void)state;
+    wc_calibration_t cal = wc_table1_calibration;
+    cal.film_squeeze_factor = 0.1f;
+    wc_model_t model;
+    assert_int_equal(wc_model_init(&model, &cal), WC_CAL_OK);
+    const double ro = (double)cal.outer_radius_m;
+    const double ri = (double)cal.inner_radius_m;
+    const double k = ro * ro * ro * ro - ri * ri * ri * ri - (ro * ro - ri * ri) * (ro * ro - ri * ri) / log(ro / ri);
+    WC_CHECK_CLOSE("film_damping_m4", 0, model.film_damping_m4, 1.5 * REF_PI * (double)cal.film_squeeze_factor * k,
+                   1e-4, 0.0);
+    printf("    K = %.6g m^4 (double), damping 3 pi phi K / 2 = %.6g m^4 at phi 0.1\n", k, (double)model.film_damping_m4);
+}
+
+/* The update is stable for every state and input (wc_film.h): from the open film and from the thinnest,
+ * under no force, the nominal, and the largest a pack takes, for the stiffest and the slowest dampings of
+ * the domain (phi 1e-4 .. 1, mu_v of Table 1's oil at 250 and -40 degC), h_bar moves monotonically towards
+ * the settled film and never past it; where the film is fast it arrives. The stiffness of the stiffest case
+ * (dt A_f |dp_c/dh_bar| h_bar^3 / D at the thinnest film, 250 degC, phi 1e-4) is printed: far above 1,
+ * where an explicit step would diverge. */
+static void test_advance_is_monotone_and_bounded(void **state)
+{
+    (void)state;
+    const wc_film_table_t *t = table1();
+    const float area = wc_table1_calibration.friction_area_m2;
+    const float dt = wc_table1_calibration.control_period_s;
+    const double k_m4 = 1.54e-7;   /* test_reynolds_factor's K, rounded */
+    const float viscosities[] = { 6.0e-4f, 3.6f };           /* Table 1's mu_v at 250 and -40 degC, Pa s */
+    const float factors[] = { 1e-4f, 0.1f, 1.0f };
+    const float forces[] = { 0.0f, 100.0f, 1188.0f, 10000.0f };
+    const float starts[] = { t->hbar_m[0], t->hbar_m[t->length - 1u], 5e-6f };
+    double stiffest = 0.0;
+    for (size_t v = 0u; v < WC_TEST_COUNT(viscosities); ++v) {
+        for (size_t f = 0u; f < WC_TEST_COUNT(factors); ++f) {
+            const float damping = (float)(1.5 * REF_PI * k_m4) * factors[f] * viscosities[v];
+            for (size_t i = 0u; i < WC_TEST_COUNT(forces); ++i) {
+                const float settled = wc_film_hbar_m(t, forces[i] / area);
+                for (size_t s0 = 0u; s0 < WC_TEST_COUNT(starts); ++s0) {
+                    float h = starts[s0];
+                    const float toward = (settled < h) ? -1.0f : 1.0f;
+                    for (int k = 0; k < 3000; ++k) {
+                        const float next = wc_film_advance_m(t, area, h, forces[i], damping, dt);
+                        WC_CHECK(isfinite(next) && (next >= t->hbar_m[t->length - 1u]) && (next <= t->hbar_m[0]),
+                                 "h_bar %g outside the table", (double)next);
+                        WC_CHECK(toward * (next - h) >= 0.0f, "moved away from the settled film: %g -> %g (settled %g)",
+                                 (double)h, (double)next, (double)settled);
+                        WC_CHECK(toward * (settled - next) >= 0.0f, "past the settled film: %g (settled %g)",
+                                 (double)next, (double)settled);
+                        h = next;
+                    }
+                    if ((viscosities[v] < 1e-3f) && (factors[f] < 1e-3f)) {  /* fast: settled within 3 s */
+                        WC_CHECK_CLOSE("settled", (long)i, h, settled, 1e-4, 0.0);
+                    }
+                }
+            }
+            /* stiffness dt / tau = A_f |dp_c/dh_bar| h_bar^3 dt / D, largest over the table's segments */
+            double stiff = 0.0;
+            for (uint32_t n = 0u; n + 1u < t->length; ++n) {
+                const double slope = (double)(t->pressure_Pa[n + 1u] - t->pressure_Pa[n]) /
+                                     (double)(t->hbar_m[n] - t->hbar_m[n + 1u]);
+                const double h3 = pow(0.5 * (double)(t->hbar_m[n] + t->hbar_m[n + 1u]), 3.0);
+                const double here = (double)area * slope * h3 * (double)dt / (double)damping;
+                stiff = (here > stiff) ? here : stiff;
+            }
+            stiffest = (stiff > stiffest) ? stiff : stiffest;
+        }
+    }
+    printf("    stiffest film step in the domain: dt / tau = %.3g (explicit Euler diverges above 2)\n", stiffest);
+    WC_CHECK(stiffest > 2.0, "the sweep does not reach a stiff case (%g)", stiffest);
+}
+
+/* Settling under a held force follows the Reynolds law: from the open film at 1188 N, Table 1's oil at
+ * 40 degC and phi 0.1, the film closes within 0.5 s (the bench's 0.05..0.1 s equivalent time constant near
+ * contact, paper 2.5), and never in one step (it is not the steady film). */
+static void test_advance_settles_like_a_squeeze_film(void **state)
+{
+    (void)state;
+    const wc_film_table_t *t = table1();
+    const float area = wc_table1_calibration.friction_area_m2;
+    const float damping = (float)(1.5 * REF_PI * 1.54e-7 * 0.1 * 0.0308);  /* mu_v(40 degC) = 30.8 mPa s */
+    const float settled = wc_film_hbar_m(t, 1188.0f / area);
+    float h = t->hbar_m[0];
+    int steps_to_90 = -1;
+    const float gap = t->hbar_m[0] - settled;
+    for (int k = 0; k < 500; ++k) {
+        h = wc_film_advance_m(t, area, h, 1188.0f, damping, 1e-3f);
+        if ((steps_to_90 < 0) && (h - settled <= 0.1f * gap)) { steps_to_90 = k + 1; }
+    }
+    printf("    open film to 90 %% of the way to the settled film at 1188 N, 40 degC, phi 0.1: %d ms\n", steps_to_90);
+    WC_CHECK((steps_to_90 > 5) && (steps_to_90 < 300), "%d steps", steps_to_90);
+    WC_CHECK_CLOSE("settled after 0.5 s", 0, h, settled, 1e-3, 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -248,6 +370,10 @@ int main(void)
         cmocka_unit_test(test_strictly_decreasing_in_pressure),
         cmocka_unit_test(test_hermite_reproduces_a_cubic),
         cmocka_unit_test(test_segment_cubic_is_the_interpolant),
+        cmocka_unit_test(test_pressure_inverts_hbar),
+        cmocka_unit_test(test_reynolds_factor),
+        cmocka_unit_test(test_advance_is_monotone_and_bounded),
+        cmocka_unit_test(test_advance_settles_like_a_squeeze_film),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

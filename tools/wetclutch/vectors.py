@@ -48,6 +48,30 @@ def hot_clutch_profile(cal: Calibration):
             "torque_request_Nm": np.where(hot, 400.0, 0.0), "mode": np.where(hot, model.MODE_TORQUE, model.MODE_OPEN)}
 
 
+# The engagement-edge series runs table1 with the squeeze-film state on and a static factor above 1 (so the
+# capacity at the steady inverse's force is not exactly the request: no marginal lock decision); the C test
+# sets the same two fields on its copy of wc_table1_calibration.
+EDGES_SQUEEZE_FACTOR = 0.1
+EDGES_STATIC_FACTOR = 1.1
+
+
+def edges_profile(cal: Calibration):
+    """Engagement edges (DESIGN 9) in 1.6 s: open at 300 rpm; torque control (120 Nm) from 0.1 s with the slip
+    falling linearly to 0 at 0.8 s (contact: the squeeze film), then +-0.5 rpm of noise (lock after the dwell);
+    the request steps to 200 Nm at 1.0 s (breakaway: the capacity lags with the VFS and the film) and the clutch
+    locks again; at 1.45 s the slip steps to -20 rpm (breakaway by slip, the other direction)."""
+    n = int(round(1.6 / cal.period))
+    k = np.arange(n)
+    t = k * cal.period
+    slip = np.where(t < 0.1, 300.0, 300.0 * np.clip((0.8 - t) / 0.7, 0.0, None))
+    slip = np.where(t >= 0.8, np.where(k % 2 == 0, 0.5, -0.5), slip)
+    slip = np.where(t >= 1.45, -20.0, slip)
+    request = np.where(t < 1.0, 120.0, 200.0)
+    mode = np.where(t < 0.1, model.MODE_OPEN, model.MODE_TORQUE)
+    return {"step": k.astype(float), "slip_rpm": slip, "theta_oil_degC": np.full(n, 40.0),
+            "theta_housing_degC": np.full(n, 40.0), "torque_request_Nm": request, "mode": mode}
+
+
 def _c_double(x: float) -> str:
     return f"{x:.9g}" if math.isfinite(x) else "NAN"
 
@@ -74,6 +98,11 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
                               hin["torque_request_Nm"], mode=hin["mode"], theta_start_degC=120.0)
     keep = np.arange(0, hin["step"].size, HOT_EVERY)
     hot = {k: np.asarray(v)[keep] for k, v in {**hin, **hout}.items()}
+    edges_cal = cal.with_values(film_squeeze_factor=EDGES_SQUEEZE_FACTOR, static_friction_factor=EDGES_STATIC_FACTOR)
+    ein = edges_profile(edges_cal)
+    eout = model.clutch_steps(edges_cal, ein["slip_rpm"], ein["theta_oil_degC"], ein["theta_housing_degC"],
+                              ein["torque_request_Nm"], mode=ein["mode"], theta_start_degC=40.0)
+    edges = {**ein, **eout, "hbar_um": eout["hbar_m"] * 1e6}
     text = (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/model.py),\n"
@@ -86,7 +115,9 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
         "typedef struct { double t_s, slip_rpm, torque_Nm, theta_oil_degC, theta_housing_degC, theta_degC; }"
         " wc_golden_thermal_t;\n"
         "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, theta_degC; int status; }"
-        " wc_golden_hot_clutch_t;\n\n"
+        " wc_golden_hot_clutch_t;\n"
+        "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, torque_Nm, hbar_um, contact_force_N,"
+        " static_capacity_Nm; int status; } wc_golden_edges_t;\n\n"
         + _table("wc_golden_torque", "wc_golden_torque_t", {**tin, **tout},
                  ("slip_rpm", "theta_degC", "force_N", "torque_Nm", "coulomb_Nm", "viscous_Nm", "hbar_um", "mu_f"))
         + "\n" + _table("wc_golden_inverse", "wc_golden_inverse_t", {**iin, **iout},
@@ -98,6 +129,12 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
         f" * every {HOT_EVERY}th step; theta_degC is the estimate used in that step. */\n"
         + _table("wc_golden_hot_clutch", "wc_golden_hot_clutch_t", hot,
                  ("step", "slip_rpm", "torque_request_Nm", "current_mA", "theta_degC", "status"))
+        + f"\n/* wc_clutch_step on the engagement-edge series (vectors.edges_profile), table1 with\n"
+        f" * film_squeeze_factor = {EDGES_SQUEEZE_FACTOR} and static_friction_factor = {EDGES_STATIC_FACTOR}: squeeze film at"
+        f" contact,\n * lock, breakaway by torque, lock, breakaway by slip. Every step. */\n"
+        + _table("wc_golden_edges", "wc_golden_edges_t", edges,
+                 ("step", "slip_rpm", "torque_request_Nm", "current_mA", "torque_Nm", "hbar_um", "contact_force_N",
+                  "static_capacity_Nm", "status"))
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )
     out_dir.mkdir(parents=True, exist_ok=True)
