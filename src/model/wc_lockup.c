@@ -27,6 +27,8 @@ bool wc_lockup_update(wc_lockup_t *lockup, const wc_calibration_t *cal, float sl
         if (!(slip_abs <= cal->breakaway_slip_rad_s) || !holds) {
             lockup->locked = false;
             lockup->dwell_periods = 0u;
+            /* the slip that broke away sets the direction (not the dither inside the band while locked) */
+            if (slip_abs >= cal->lock_slip_rad_s) { lockup->direction = (slip_rad_s < 0.0f) ? (int8_t)-1 : (int8_t)1; }
         }
         return lockup->locked;
     }

@@ -431,6 +431,68 @@ static void test_engagement_edges_match_golden(void **state)
     assert_true(clutch.lockup.direction < 0);  /* after the slip reversed */
 }
 
+/* Film state off (film_squeeze_factor = 0, table1): the step's torque is the paper's steady model, bit for
+ * bit: wc_torque at the modelled force (eq. 16) and the estimate's temperature. Slips outside the lock band. */
+static void test_film_off_is_the_steady_model_bit_for_bit(void **state)
+{
+    (void)state;
+    const wc_calibration_t *cal = &wc_table1_calibration;
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, cal, 40.0f), WC_CAL_OK);
+    assert_true(clutch.model.film_damping_m4 <= 0.0f);
+    for (int k = 0; k < 600; ++k) {
+        wc_step_input_t in;
+        memset(&in, 0, sizeof in);
+        in.slip_rad_s = wc_test_rpm_to_rad_s(750.0 - 1.2 * k);
+        in.theta_oil_degC = 40.0f;
+        in.theta_housing_degC = 40.0f;
+        in.torque_request_Nm = 150.0f;
+        in.mode = (k < 50) ? WC_MODE_OPEN : WC_MODE_TORQUE;
+        wc_step_output_t out;
+        (void)wc_clutch_step(&clutch, &in, &out);
+        const float force_N = wc_contact_force_N(cal, out.pressure_model_Pa);
+        wc_torque_t steady;
+        assert_int_equal(wc_torque(&clutch.model, in.slip_rad_s, out.theta_degC, force_N, &steady), WC_STATUS_OK);
+        WC_CHECK(wc_test_same_float(out.contact_force_N, force_N), "step %d: force %g vs %g", k,
+                 (double)out.contact_force_N, (double)force_N);
+        WC_CHECK(wc_test_same_float(out.model.torque_Nm, steady.torque_Nm) &&
+                     wc_test_same_float(out.model.hbar_m, steady.hbar_m),
+                 "step %d: torque %.9g vs steady %.9g", k, (double)out.model.torque_Nm, (double)steady.torque_Nm);
+    }
+}
+
+/* The lock-up never flaps (DESIGN 8, 9): a slip dithering across the lock band's edge never locks (the dwell
+ * restarts), a locked clutch stays locked while the slip dithers inside the breakaway band, breaks away at
+ * once when the slip leaves it or the torque reaches the capacity, and takes the dwell to lock again. */
+static void test_lockup_hysteresis_and_dwell(void **state)
+{
+    (void)state;
+    const wc_calibration_t *cal = &wc_table1_calibration;  /* lock 0.3 rad/s, breakaway 0.8, dwell 10 */
+    wc_lockup_t lock;
+    wc_lockup_init(&lock);
+    for (int k = 0; k < 100; ++k) {  /* 0.25 / 0.35 rad/s: in and out of the lock band */
+        assert_false(wc_lockup_update(&lock, cal, ((k & 1) != 0) ? 0.35f : -0.25f, 10.0f, 100.0f));
+    }
+    for (uint32_t k = 1u; k <= cal->lock_dwell_periods; ++k) {  /* inside: locks after exactly the dwell */
+        const bool locked = wc_lockup_update(&lock, cal, ((k & 1u) != 0u) ? 0.1f : -0.1f, 10.0f, 100.0f);
+        assert_int_equal(locked, k == cal->lock_dwell_periods);
+    }
+    assert_int_equal(lock.direction, 1);  /* the last slip outside the band was +0.35 */
+    for (int k = 0; k < 100; ++k) {  /* dithering inside the breakaway band, torque below the capacity */
+        assert_true(wc_lockup_update(&lock, cal, ((k & 1) != 0) ? 0.75f : -0.75f, 99.0f, 100.0f));
+    }
+    assert_true(wc_lockup_torque_Nm(&lock, 150.0f, 100.0f) <= 100.0f);   /* bounded by the capacity */
+    assert_true(wc_lockup_torque_Nm(&lock, -30.0f, 100.0f) >= 0.0f);     /* never the other sign */
+    assert_false(wc_lockup_update(&lock, cal, 0.0f, 100.0f, 100.0f));    /* torque reaches the capacity */
+    assert_false(wc_lockup_update(&lock, cal, 0.0f, 10.0f, 100.0f));     /* the dwell again */
+    for (uint32_t k = 2u; k < cal->lock_dwell_periods; ++k) { assert_false(wc_lockup_update(&lock, cal, 0.0f, 10.0f, 100.0f)); }
+    assert_true(wc_lockup_update(&lock, cal, 0.0f, 10.0f, 100.0f));
+    assert_false(wc_lockup_update(&lock, cal, -0.81f, 10.0f, 100.0f));  /* slip leaves the breakaway band */
+    assert_int_equal(lock.direction, -1);
+    assert_false(wc_lockup_update(&lock, cal, NAN, 10.0f, 100.0f));     /* NaN: slipping */
+    for (int k = 0; k < 20; ++k) { assert_false(wc_lockup_update(&lock, cal, 0.0f, 10.0f, 0.0f)); }  /* no force */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -442,6 +504,8 @@ int main(void)
         cmocka_unit_test(test_two_instances_do_not_interfere),
         cmocka_unit_test(test_thermal_envelope_matches_golden),
         cmocka_unit_test(test_engagement_edges_match_golden),
+        cmocka_unit_test(test_film_off_is_the_steady_model_bit_for_bit),
+        cmocka_unit_test(test_lockup_hysteresis_and_dwell),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -234,6 +234,8 @@ class Lockup:
         if self.locked:
             if not (abs(slip_rad_s) <= cal.breakaway_slip) or not holds:
                 self.locked, self.dwell = False, 0
+                if abs(slip_rad_s) >= cal.lock_slip:   # the slip that broke away sets the direction
+                    self.direction = -1.0 if slip_rad_s < 0.0 else 1.0
             return self.locked
         if abs(slip_rad_s) < cal.lock_slip and holds:
             self.dwell = min(self.dwell + 1, 255)
