@@ -361,6 +361,7 @@ class _Profile:
         self.kind = exps[0].kind
         self.dt = dt
         self.force = np.array([e.force_N for e in exps])
+        self.no_force = np.zeros(len(exps))
         self.slip = np.array([e.slip_rpm for e in exps]) * RPM
         self.t_down = np.array([CAMPAIGN_HOLD_S + e.loading_s for e in exps])
         self.never = np.zeros(len(exps), dtype=bool)
@@ -375,8 +376,9 @@ class _Profile:
                 self.ref[:, j] = levels[idx] * np.where(t_grid < CAMPAIGN_HOLD_S, ramp, 1.0)
 
     def force_command(self, t: float):
+        """The commanded force: one of two fixed arrays (so `is` tells an unchanged command)."""
         start = ENGAGEMENT_CONTACT_S if self.kind == "engagement" else CAMPAIGN_FORCE_S
-        return self.force if t >= start - 1e-12 else np.zeros_like(self.force)
+        return self.force if t >= start - 1e-12 else self.no_force
 
     def speed_ref(self, k: int, t: float):
         if self.kind in ("engagement", "breakaway"):     # breakaway: torque-controlled, the reference unused
@@ -599,6 +601,7 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
     h = film.separation_from_pressure_m(f_app / area)
     film_settled = np.zeros(n, dtype=bool)   # the last step left h and F_app unchanged (see the film update)
     film_cmd = np.zeros(n)                   # the force command of that step
+    all_settled = False
     if prof.kind == "engagement":
         w = prof.slip.copy()                 # spinning at the initial slip, clutch open
         locked = np.zeros(n, dtype=bool)
@@ -672,8 +675,8 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
             motor_off |= enabled & off_zero & (speed_meas <= 0.0)
         torque_motor = torque_motor * (enabled & ~motor_off)
 
-        h_target = film.separation_from_pressure_m(f_app / area)
         if k % every == 0:
+            h_target = film.separation_from_pressure_m(f_app / area)     # the steady film under F_app
             r = k // every
             t_rows[r] = t
             modes[r] = prof.mode(t)
@@ -710,12 +713,13 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
         if phys.phi == 0.0:
             # film state off (calibration: film_squeeze_factor 0): the paper's steady film, F_c = F_app
             h = film.separation_from_pressure_m(f_app_next / area)
-        else:
+        elif not (all_settled and f_cmd is film_cmd):
             # The squeeze film. A step that left both h and the actuator force unchanged to the last bit
             # found the film at its equilibrium F_c(h) = F_app, which the viscosity (the one input that
             # still changes) does not move (F_h = 0 there): the film is not integrated again until the
             # force command changes, so the runs at constant force cost nothing more once settled. Per
-            # experiment, so a run gives the same numbers alone or in a batch.
+            # experiment, so a run gives the same numbers alone or in a batch. (When all are settled
+            # under the same command, nothing changes: not even the checks are repeated.)
             active = ~(film_settled & (f_cmd == film_cmd))
             if active.all():
                 h_next = phys.film_step(h, f_app, f_cmd, theta)
@@ -726,6 +730,7 @@ def simulate(true_cal: Calibration, exps: list[Experiment], seed: int = DEFAULT_
             else:
                 h_next = h
             film_settled = (h_next == h) & (f_app_next == f_app)
+            all_settled = bool(film_settled.all())
             film_cmd = f_cmd
             h = h_next
         f_app = f_app_next
