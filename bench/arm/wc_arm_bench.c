@@ -88,6 +88,7 @@ static const float request_grid[] = {0.0f, 0.05f, 0.3f, 0.6f, 0.9f, 1.1f};
 
 typedef enum {
     ROW_CLUTCH_STEP = 0,
+    ROW_CLUTCH_STEP_FILM,
     ROW_INVERSE_SOLVE,
     ROW_INVERSE_BELOW_DRAG,
     ROW_INVERSE_SATURATED,
@@ -110,6 +111,7 @@ typedef enum {
 /* Names as in bench/arm_ceilings.txt (no spaces). */
 static const char *const row_name[ROWS] = {
     [ROW_CLUTCH_STEP] = "wc_clutch_step",
+    [ROW_CLUTCH_STEP_FILM] = "wc_clutch_step:film",
     [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
     [ROW_INVERSE_BELOW_DRAG] = "wc_inverse:below_drag",
     [ROW_INVERSE_SATURATED] = "wc_inverse:saturated",
@@ -333,6 +335,7 @@ static void put_point(float slip_rpm, float theta_degC, float fraction)
 
 static wc_model_t model;
 static wc_clutch_t clutch;
+static wc_calibration_t film_calibration;  /* table1 with the squeeze-film state on (DESIGN 9) */
 static wc_loop_t loop;
 static bench_ctx_t ctx;
 
@@ -428,6 +431,12 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
     if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step rejected a grid point"); }
     const wc_step_output_t step = ctx.step_out;
 
+    /* The same with the squeeze-film state on: a fresh clutch (open film), the 4th step measured. */
+    if (wc_clutch_init(&clutch, &film_calibration, theta_degC) != WC_CAL_OK) { fail("wc_clutch_init (film)"); }
+    for (uint32_t k = 0u; k < WARMUP_STEPS; ++k) { thunk_clutch_step(&ctx); }
+    record(ROW_CLUTCH_STEP_FILM, measure(thunk_clutch_step, &ctx));
+    if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step (film) rejected a grid point"); }
+
     /* wc_loop_step: both input frames queued every period, the 4th step measured. */
     /* The default configuration with a one-period recovery debounce, so that the
      * 4th step is a controlling one (the debounce counts periods, it costs nothing). */
@@ -463,7 +472,7 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
     ctx.vfs = (wc_can_vfs_command_phys_t){step.current_mA, 0.001f * step.pressure_command_Pa, 0u, WARMUP_STEPS};
     record(ROW_ENCODE_VFS_COMMAND, measure(thunk_encode_vfs_command, &ctx));
     ctx.estimate = (wc_can_clutch_estimate_phys_t){step.theta_degC, step.model.torque_Nm, step.model.mu_f,
-                                                   1.0e6f * step.model.hbar_m};
+                                                   1.0e6f * step.model.hbar_m, 0u};
     record(ROW_ENCODE_CLUTCH_ESTIMATE, measure(thunk_encode_clutch_estimate, &ctx));
     record(ROW_CRC8, measure(thunk_crc8, &ctx));
 }
@@ -509,6 +518,8 @@ int main(void)
     wc_arm_puts(" (a block of 1000 nops; must read 1000 +- 1)\n");
     if ((nops + 1u < NOP_BLOCK) || (nops > NOP_BLOCK + 1u)) { fail("1000 nops do not read 1000"); }
 
+    film_calibration = *wc_arm_calibration;
+    film_calibration.film_squeeze_factor = 0.1f;  /* the bench's (tools/calibrations/bench_true.toml) */
     if (wc_model_init(&model, wc_arm_calibration) != WC_CAL_OK) {
         fail("wc_model_init(table1)");
     } else {

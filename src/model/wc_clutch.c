@@ -7,6 +7,7 @@
 #include "wetclutch/wc_hydraulics.h"
 #include "wc_internal.h"
 #include "wetclutch/wc_thermal.h"
+#include "wc_lockup_internal.h"
 #include "wc_operating_point.h"
 
 /* DESIGN section 3 / issue "state <= 64 B per clutch" (60 B on Cortex-M4F, 64 B on a 64-bit host). */
@@ -70,9 +71,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     WC_ASSERT(wc_theta_valid(clutch->theta_degC));
     wc_torque_point_t point;
     wc_torque_point(model, u->slip_rad_s, clutch->theta_degC, &point);
+    const float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
     wc_inverse_t inv;
     if ((in->mode == WC_MODE_TORQUE) && clutch->lockup.locked) {
-        status |= wc_inverse_holding_at_point(model, &point, u->torque_request_Nm, &inv);  /* DESIGN 9 */
+        status |= wc_inverse_holding(model, static_Nm_per_N, u->torque_request_Nm, &inv);  /* DESIGN 9 */
     } else if (in->mode == WC_MODE_TORQUE) {
         status |= wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv);
     } else {
@@ -121,11 +123,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     }
 
     /* DESIGN 9: lock-up against the static capacity at the contact force. */
-    out->static_capacity_Nm = point.static_Nm_per_N * out->contact_force_N;
+    out->static_capacity_Nm = static_Nm_per_N * out->contact_force_N;
     const float required_Nm = bench_torque ? in->bench.torque_Nm : direction * u->torque_request_Nm;
-    const bool locked = wc_lockup_update(&clutch->lockup, cal, u->slip_rad_s, required_Nm, out->static_capacity_Nm);
+    const bool locked = wc_lockup_advance(&clutch->lockup, cal, u->slip_rad_s, required_Nm, out->static_capacity_Nm);
     if (locked) {
-        out->model.torque_Nm = wc_lockup_torque_Nm(&clutch->lockup, required_Nm, out->static_capacity_Nm);
+        out->model.torque_Nm = wc_lockup_held_Nm(&clutch->lockup, required_Nm, out->static_capacity_Nm);
         out->model.coulomb_Nm = out->model.torque_Nm;  /* static friction only: no slip, no viscous shear */
         out->model.viscous_Nm = 0.0f;
         status |= WC_STATUS_LOCKED;

@@ -9,8 +9,8 @@
 #define WC_STRIBECK_NEGLIGIBLE 30.0f
 
 /* eq. 18 for a temperature in the model's domain (the inverse and the torque
- * model call it with a checked one). */
-float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float theta_degC)
+ * model call it with a checked one), given as its temperature factor. */
+float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float temperature_factor)
 {
     /* eq. 18: Stribeck exponential in speed times a linear temperature term.
      * Above 30 Stribeck speeds e^-x < 1e-13: (mu2 - mu1) e^-x is below half an
@@ -19,7 +19,7 @@ float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float theta_d
     const float x = fabsf(speed_m_s) / cal->stribeck_speed_m_s;
     const float decay = (x < WC_STRIBECK_NEGLIGIBLE) ? wc_exp(-x) : 0.0f;
     const float stribeck = cal->mu1 + (cal->mu2 - cal->mu1) * decay;
-    return stribeck * (1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K);
+    return stribeck * temperature_factor;
 }
 
 float wc_friction_coefficient(const wc_calibration_t *cal, float speed_m_s, float theta_degC)
@@ -32,5 +32,5 @@ float wc_friction_coefficient(const wc_calibration_t *cal, float speed_m_s, floa
     const float theta = (theta_degC >= WC_THETA_MIN_degC)
                             ? ((theta_degC <= WC_THETA_MAX_degC) ? theta_degC : WC_THETA_MAX_degC)
                             : WC_THETA_MIN_degC;
-    return wc_friction_at(cal, speed_m_s, theta);
+    return wc_friction_at(cal, speed_m_s, wc_friction_temperature_factor(cal, theta));
 }

@@ -66,9 +66,17 @@ static inline float wc_vfs_lag_at(const wc_model_t *model, float pressure_reache
     return target_Pa + (pressure_reached_Pa - target_Pa) * model->vfs_decay;
 }
 
-/* eq. 18 without the input clamping of wc_friction_coefficient: the theta must
- * be in [WC_THETA_MIN_degC, WC_THETA_MAX_degC] (src/model/wc_friction.c). */
-float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float theta_degC);
+/* The temperature factor of eq. 18, 1 + mu3 (theta - theta1) / theta2: also
+ * the static capacity's (DESIGN 9, mu_f(0, theta) = mu2 times it). */
+static inline float wc_friction_temperature_factor(const wc_calibration_t *cal, float theta_degC)
+{
+    return 1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K;
+}
+
+/* eq. 18 without the input clamping of wc_friction_coefficient, for the
+ * temperature factor of a theta in [WC_THETA_MIN_degC, WC_THETA_MAX_degC]
+ * (src/model/wc_friction.c). */
+float wc_friction_at(const wc_calibration_t *cal, float speed_m_s, float temperature_factor);
 
 /* e^x within 2 ulp of expf on [-87, 88], in about a third of newlib's
  * instructions (src/model/wc_exp.c; tests/c/test_exp.c). */

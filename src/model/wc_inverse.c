@@ -171,15 +171,15 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
     return status;
 }
 
-wc_status_t wc_inverse_holding_at_point(const wc_model_t *model, const wc_torque_point_t *point,
-                                        float torque_request_Nm, wc_inverse_t *out)
+wc_status_t wc_inverse_holding(const wc_model_t *model, float static_Nm_per_N, float torque_request_Nm,
+                               wc_inverse_t *out)
 {
     /* DESIGN 9: a locked clutch carries the request if its static capacity
      * does, c_s F_c > T_req; the margin keeps it locked against the
      * capacity's error. c_s > 0 on the domain (mu2 >= 1e-3, a positive
      * temperature factor and static factor: wc_calibration_check). */
     wc_status_t status = WC_STATUS_OK;
-    float force_N = torque_request_Nm * (1.0f + model->cal->holding_margin) / point->static_Nm_per_N;
+    float force_N = torque_request_Nm * (1.0f + model->cal->holding_margin) / static_Nm_per_N;
     if (!(force_N <= model->force_max_N)) {  /* the request's range makes it finite; NaN cannot occur */
         force_N = model->force_max_N;
         status |= WC_STATUS_SATURATED;

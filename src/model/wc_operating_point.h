@@ -17,7 +17,7 @@ typedef struct {
     float viscous_Nm_m;      /* R_eff N_c mu_v(theta) A_f v, eq. 7 times h_bar */
     float mu_f;
     float viscosity_Pa_s;    /* mu_v(theta), eq. 2: the squeeze film's damping (DESIGN 9) */
-    float static_Nm_per_N;   /* static capacity per newton of contact force (DESIGN 9) */
+    float temperature_factor; /* 1 + mu3 (theta - theta1) / theta2 of eq. 18: the static capacity's too */
 } wc_torque_point_t;
 
 /* mu_f, mu_v at a valid (slip, theta). */
@@ -32,15 +32,33 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
                                 wc_inverse_t *out);
 
 /* The inverse for a locked clutch (DESIGN 9): the force whose static capacity
- * holds torque_request_Nm with the calibration's holding margin, clamped to
- * the force at the maximum current (WC_STATUS_SATURATED). */
-wc_status_t wc_inverse_holding_at_point(const wc_model_t *model, const wc_torque_point_t *point,
-                                        float torque_request_Nm, wc_inverse_t *out);
+ * (static_Nm_per_N > 0 per newton) holds torque_request_Nm with the
+ * calibration's holding margin, clamped to the force at the maximum current
+ * (WC_STATUS_SATURATED). */
+wc_status_t wc_inverse_holding(const wc_model_t *model, float static_Nm_per_N, float torque_request_Nm,
+                               wc_inverse_t *out);
+
+/* Static capacity per newton of contact force at the point (DESIGN 9): the static factor times
+ * mu_f(0, theta) R_eff N_c, eq. 18 at v = 0: mu_f(0, theta) = mu2 (1 + mu3 (theta - theta1) / theta2). */
+static inline float wc_static_capacity_Nm_per_N(const wc_model_t *model, const wc_torque_point_t *point)
+{
+    const wc_calibration_t *cal = model->cal;
+    return model->effective_radius_m * (float)cal->friction_pairs * cal->static_friction_factor * cal->mu2 *
+           point->temperature_factor;
+}
 
 /* eq. 5-8 at the point for a contact force and the film it stands on (the
  * steady film of eq. 16, or the squeeze-film state of DESIGN 9). */
-void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N, float hbar_m,
-                       wc_torque_t *out);
+static inline void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N,
+                                     float hbar_m, wc_torque_t *out)
+{
+    const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
+    out->coulomb_Nm = sign * point->coulomb_Nm_per_N * force_N;   /* eq. 6 */
+    out->viscous_Nm = sign * point->viscous_Nm_m / hbar_m;        /* eq. 7 */
+    out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;           /* eq. 5 */
+    out->hbar_m = hbar_m;
+    out->mu_f = point->mu_f;
+}
 
 /* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]
  * (p = p_k + t (p_k+1 - p_k)): h_bar(t) = c[0] + t (c[1] + t (c[2] + t c[3])).

@@ -14,13 +14,11 @@ void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC
     const wc_calibration_t *cal = model->cal;
     const float speed_m_s = model->effective_radius_m * fabsf(slip_rad_s);                  /* eq. 4 */
     const float torque_arm_m = model->effective_radius_m * (float)cal->friction_pairs;      /* R_eff N_c */
-    point->mu_f = wc_friction_at(cal, speed_m_s, theta_degC);                              /* eq. 18 */
+    point->temperature_factor = wc_friction_temperature_factor(cal, theta_degC);             /* eq. 18 */
+    point->mu_f = wc_friction_at(cal, speed_m_s, point->temperature_factor);                /* eq. 18 */
     point->coulomb_Nm_per_N = torque_arm_m * point->mu_f;                            /* eq. 6 */
     point->viscosity_Pa_s = wc_viscosity_Pa_s(cal, theta_degC);                           /* eq. 2 */
     point->viscous_Nm_m = torque_arm_m * point->viscosity_Pa_s * cal->friction_area_m2 * speed_m_s;  /* eq. 7 */
-    /* DESIGN 9: static factor times mu_f(0, theta) = mu2 (1 + mu3 (theta - theta1) / theta2), eq. 18 at v = 0 */
-    point->static_Nm_per_N = torque_arm_m * cal->static_friction_factor * cal->mu2 *
-                             (1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K);
 }
 
 /* The documented answer to rejected input (wc_torque.h): zero torque with the open-clutch film. */
@@ -41,16 +39,6 @@ void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point,
     wc_torque_at_film(point, slip_rad_s, force_N, hbar_m, out);
 }
 
-void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N, float hbar_m,
-                       wc_torque_t *out)
-{
-    const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
-    out->coulomb_Nm = sign * point->coulomb_Nm_per_N * force_N;   /* eq. 6 */
-    out->viscous_Nm = sign * point->viscous_Nm_m / hbar_m;        /* eq. 7 */
-    out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;           /* eq. 5 */
-    out->hbar_m = hbar_m;
-    out->mu_f = point->mu_f;
-}
 
 wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_degC, float force_N,
                       wc_torque_t *out)
