@@ -208,7 +208,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.set_defaults(func=_cmd_replay)
 
     q = sub.add_parser("identify", help="identify mu_f, k1/k2, viscosity, asperity density from bench data")
-    q.add_argument("step", choices=["mu", "thermal", "viscosity", "asperity", "all"])
+    q.add_argument("step", choices=["mu", "thermal", "viscosity", "asperity", "film", "static", "all"])
     q.add_argument("data_dir", help="bench data: index.csv + measurement CSVs (+ thermal/, viscosity.csv)")
     q.add_argument("--calibration", "-c", default=DEFAULT_CAL, help="base calibration TOML")
     q.add_argument("--out", default="out/identify", help="output directory (default out/identify)")

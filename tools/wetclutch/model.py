@@ -213,6 +213,76 @@ def film_advance_m(cal: Calibration, hbar_m: float, apply_force_N: float, theta_
     return 1.0 / math.sqrt(u_next) if (u_next > u if closing else u_next < u) else hbar_m
 
 
+class FilmDynamics:
+    """The squeeze-film state (DESIGN 9) of many runs at once, in double: the firmware's update
+    (film_advance_m) vectorized over runs, with eq. 9/15 on a dense table in h (linear interpolation,
+    `nodes` separations over the film domain) instead of the exact closed forms. For the identification
+    and the plant-family study, where a run is thousands of steps and a fit hundreds of runs."""
+
+    def __init__(self, cal: Calibration, nodes: int = 4001):
+        h_min, h_max, _, _ = film_domain(cal)
+        h = np.linspace(h_max, h_min, nodes)
+        self.cal = cal
+        self.hbar_m = film_thickness_m(cal, h)                 # decreasing along the table
+        self.pressure_Pa = contact_pressure_Pa(cal, h)         # increasing
+        x = h / (math.sqrt(2.0) * cal.roughness_rms)
+        enb = cal.youngs_modulus * cal.asperity_density * cal.asperity_tip_radius
+        self.slope_Pa_per_m = -(math.pi / 2.0) * enb * erfc(x) / (0.5 * (1.0 + erf(x)))   # dp_c/dh_bar
+        self.reynolds_m4 = reynolds_factor_m4(cal)
+
+    def contact_pressure_Pa(self, hbar_m):
+        """(p_c, dp_c/dh_bar) at film h_bar: 0 at or above the open film (wc_film_pressure_Pa)."""
+        hb = np.asarray(hbar_m, dtype=float)
+        p = np.interp(-hb, -self.hbar_m, self.pressure_Pa)
+        slope = np.interp(-hb, -self.hbar_m, self.slope_Pa_per_m)
+        return np.where(hb >= self.hbar_m[0], 0.0, p), slope
+
+    def settled_m(self, force_N):
+        """The steady film under an apply force (eq. 16), clamped to the table."""
+        return np.interp(np.asarray(force_N, dtype=float) / self.cal.friction_area, self.pressure_Pa, self.hbar_m)
+
+    def advance_m(self, hbar_m, force_N, damping_N_s_m2, dt_s):
+        """film_advance_m for arrays (same scheme: linearly implicit in u = 1/h_bar^2, never past settled)."""
+        area = self.cal.friction_area
+        settled = self.settled_m(force_N)
+        p, slope = self.contact_pressure_Pa(hbar_m)
+        squeeze = force_N - area * p
+        u = 1.0 / hbar_m**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u_next = u + 2.0 * dt_s * squeeze / (damping_N_s_m2 - dt_s * area * slope * hbar_m**3)
+        u_settled = 1.0 / settled**2
+        closing = u_settled > u
+        short = np.where(closing, u_next < u_settled, u_next > u_settled)
+        forward = np.where(closing, u_next > u, u_next < u)
+        with np.errstate(invalid="ignore"):
+            moved = np.where(forward, 1.0 / np.sqrt(np.where(u_next > 0, u_next, 1.0)), hbar_m)
+        return np.where(short, moved, settled)
+
+    def run(self, force_N, theta_degC, squeeze_factor: float, dt_s: float | None = None, substeps: int = 1):
+        """Film h_bar and asperity force F_c per row (steps x runs), each row the state the torque of that
+        step uses (before its update, as wc_clutch_step); starts settled under the first row's force.
+        squeeze_factor 0: the steady film (eq. 16). substeps > 1 divides each period (the continuous law)."""
+        force = np.atleast_2d(np.asarray(force_N, dtype=float).T).T
+        theta = np.broadcast_to(np.atleast_2d(np.asarray(theta_degC, dtype=float).T).T, force.shape)
+        if squeeze_factor <= 0.0:
+            hbar = self.settled_m(force)
+            return hbar, force.copy()
+        dt = (self.cal.period if dt_s is None else dt_s) / substeps
+        damping = 1.5 * math.pi * squeeze_factor * self.reynolds_m4 * viscosity_Pa_s(self.cal, theta)
+        out = np.empty(force.shape)
+        h = self.settled_m(force[0])
+        for k in range(force.shape[0]):
+            out[k] = h
+            for _ in range(substeps):
+                h = self.advance_m(h, force[k], damping[k], dt)
+        return out, self.cal.friction_area * self.contact_pressure_Pa(out)[0]
+
+
+def torque_at_film_Nm(cal: Calibration, slip_rpm, theta_degC, contact_force_N, hbar_m):
+    """Eq. 5-8 for a contact force and the film it stands on, signed with the slip (arrays)."""
+    return torque_parts(cal, slip_rpm, theta_degC, contact_force_N, hbar_m=hbar_m)["torque_Nm"]
+
+
 def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
     """Static capacity: static factor mu_f(0, theta) R_eff N_c F_c (DESIGN 9; eq. 18 at v = 0)."""
     return (cal.static_friction_factor * friction_coefficient(cal, 0.0, theta_degC)

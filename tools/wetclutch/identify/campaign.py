@@ -7,8 +7,9 @@ A data directory as ``wetclutch bench`` writes it: per campaign an index CSV
 theta_housing_degC[, torque_request_Nm]``), and ``viscosity.csv``
 (``theta_degC, viscosity_Pa_s``). The index may be in the directory itself or
 in its sub-directories (``table2/``, ``thermal/``); a campaign whose directory
-or index name says ``thermal`` holds the thermal runs, ``engagement`` runs are
-not used, every other campaign is a friction campaign (Table 2).
+or index name says ``thermal`` holds the thermal runs, ``engagement`` the
+engagement runs (the film step), ``breakaway`` the breakaway runs (the static
+step), every other campaign is a friction campaign (Table 2).
 The CSV parsing itself is csvio's; errors from it are raised as IdentifyError.
 """
 from __future__ import annotations
@@ -62,7 +63,7 @@ def _header(path: Path) -> list[str] | None:
 
 @dataclass
 class Campaign:
-    kind: str             # "friction", "thermal" or "engagement"
+    kind: str             # "friction", "thermal", "engagement" or "breakaway"
     index: Path
     rows: list[dict]      # index rows: id, file (Path), and the other columns
 
@@ -78,6 +79,8 @@ def _kind(index: Path) -> str:
         return "thermal"
     if "engagement" in name:
         return "engagement"
+    if "breakaway" in name:
+        return "breakaway"
     return "friction"
 
 

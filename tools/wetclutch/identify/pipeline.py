@@ -1,7 +1,8 @@
 """The command: run the steps in order (``run``) and write what they found (``write_outputs``).
 
-``all`` runs thermal -> viscosity -> asperity -> mu, each step using what the
-previous ones found (the calibration values and the thermistor lag).
+``all`` runs thermal -> viscosity -> asperity -> mu -> film -> static, each step
+using what the previous ones found (the calibration values and the thermistor
+lag); film and static run when the data hold engagement / breakaway runs.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from .. import lut
 from ..atomic import Staged
 from ..calibration import Calibration, CalibrationError, load as load_calibration, render_calibration
 from .campaign import Campaign, find_campaigns, find_viscosity, prepare_campaign
+from .edges import identify_film, identify_static, read_runs
 from .friction import friction_data, identify_asperity, identify_mu
 from .report import write_report
 from .result import Result, identified_sources, identified_values
@@ -19,7 +21,8 @@ from .settings import IdentifyError, Settings
 from .thermal import identify_thermal
 from .viscosity import identify_viscosity
 
-STEPS = ("thermal", "viscosity", "asperity", "mu")
+STEPS = ("thermal", "viscosity", "asperity", "mu", "film", "static")
+EDGE_KINDS = {"film": "engagement", "static": "breakaway"}   # the engagement edges' steps and their runs
 
 
 def run(step: str, data_dir: Path, base: Calibration, s: Settings) -> Result:
@@ -32,11 +35,9 @@ def run(step: str, data_dir: Path, base: Calibration, s: Settings) -> Result:
     clock = time.perf_counter()
     need_friction = any(x in steps for x in ("asperity", "mu"))
     need_thermal = "thermal" in steps
-    campaigns = find_campaigns(data_dir, res.notes) if (need_friction or need_thermal) else []
+    need_edges = any(x in steps for x in EDGE_KINDS)
+    campaigns = find_campaigns(data_dir, res.notes) if (need_friction or need_thermal or need_edges) else []
     res.campaigns = [{"index": str(c.index), "kind": c.kind, "experiments": len(c.rows)} for c in campaigns]
-    for c in campaigns:
-        if c.kind == "engagement":
-            res.notes.append(f"{c.index}: engagement runs ({len(c.rows)}) are not used for identification")
     cal = base
     tau = s.thermistor_lag_s
     tau_source = "--thermistor-lag" if tau is not None else None
@@ -53,6 +54,21 @@ def run(step: str, data_dir: Path, base: Calibration, s: Settings) -> Result:
 
     if need_friction:
         cal = _run_friction(res, campaigns, steps, cal, s, tau, tau_source)
+    for step_name, kind in EDGE_KINDS.items():
+        if step_name not in steps:
+            continue
+        if step == "all" and not any(c.kind == kind for c in campaigns):
+            res.notes.append(f"{step_name}: no {kind} runs in {data_dir}: step skipped")
+            continue
+        t0 = time.perf_counter()
+        runs = read_runs(campaigns, kind)
+        if not runs:
+            raise IdentifyError(f"{data_dir}: no {kind} campaign (an index in a directory or file named '{kind}')"
+                                f" for the {step_name} step")
+        r = (identify_film if step_name == "film" else identify_static)(runs, cal)
+        res.results[step_name] = r
+        cal = cal.with_values(**r["values"])
+        res.timings[step_name] = time.perf_counter() - t0
     res.cal = cal
     res.timings["total"] = time.perf_counter() - clock
     return res

@@ -26,7 +26,10 @@ SYMBOLS = {  # calibration name -> the paper's symbol
     "oil_conductance": "k1", "housing_conductance": "k2", "mv1": "mu_v1", "mv2": "mu_v2", "mv3": "mu_v3",
     "mv4": "mu_v4", "asperity_density": "N", "mu1": "mu1", "mu2": "mu2", "mu3": "mu3", "stribeck_speed": "v_s",
     "separator_specific_heat": "c_p,separator", "lining_specific_heat": "c_p,lining",
+    "film_squeeze_factor": "phi", "static_friction_factor": "k_static",
 }
+EDGE_PARAMETERS = ("film_squeeze_factor", "static_friction_factor")   # issue 12: within 5 % of the truth
+EDGE_REL_ERROR = 0.05
 TARGET_PARAMETERS = ("mu1", "mu2", "mu3", "stribeck_speed", "oil_conductance", "housing_conductance")
 EXCLUSION_COLUMNS = ["step", "experiment", "reason", "t_from_s", "t_to_s", "samples", "seconds"]
 
@@ -71,6 +74,8 @@ def _parameters(res: Result, truth: dict | None) -> dict:
             entry["error_pct"] = _num((v / truth[name] - 1.0) * 100.0)
             if name in TARGET_PARAMETERS:
                 entry["within_3pct"] = bool(abs(v / truth[name] - 1.0) <= TARGETS["rel_error"])
+            if name in EDGE_PARAMETERS:
+                entry["within_5pct"] = bool(abs(v / truth[name] - 1.0) <= EDGE_REL_ERROR)
         params[name] = entry
     return params
 
@@ -130,6 +135,9 @@ def _targets(res: Result, params: dict, truth: dict | None) -> dict:
         for name in TARGET_PARAMETERS:
             if name in params and "within_3pct" in params[name]:
                 targets[f"{SYMBOLS[name]} within 3%"] = params[name]["within_3pct"]
+        for name in EDGE_PARAMETERS:
+            if name in params and "within_5pct" in params[name]:
+                targets[f"{SYMBOLS[name]} within 5%"] = params[name]["within_5pct"]
     targets[f"runtime < {TARGETS['runtime_s']:g} s"] = bool(res.timings["total"] < TARGETS["runtime_s"])
     return targets
 
@@ -152,6 +160,9 @@ def figures(res: Result, command: str, truth: dict | None, true_path: str | None
         fig["viscosity"] = _viscosity_figures(res, truth)
     if "asperity" in res.results:
         fig["asperity"] = _asperity_figures(res.results["asperity"])
+    for step in ("film", "static"):
+        if step in res.results:
+            fig[step] = {k: v for k, v in res.results[step].items() if k not in ("values", "ci95")}
     fig["exclusions"] = {"events": len(res.exclusions), "by_reason": _exclusion_summary(res.exclusions)}
     fig["targets"] = _targets(res, params, truth)
     return fig
@@ -204,6 +215,10 @@ def markdown(res: Result, fig: dict) -> str:
         L += _md_viscosity(fig["viscosity"])
     if "asperity" in fig:
         L += _md_asperity(fig["asperity"])
+    if "film" in fig:
+        L += _md_film(fig["film"], res.results["film"]["values"]["film_squeeze_factor"])
+    if "static" in fig:
+        L += _md_static(fig["static"], res.results["static"]["values"]["static_friction_factor"])
     L += _md_exclusions(fig)
     L += _md_output(res, fig)
     return "\n".join(L) + "\n"
@@ -336,6 +351,36 @@ def _md_asperity(a: dict) -> list[str]:
           " about twice as uncertain as the drag slope; it also inherits the viscosity curve's error one"
           " to one (mu_v/h_bar is what the slope measures).", ""]
     return L
+
+
+def _md_film(f: dict, phi: float) -> list[str]:
+    """The squeeze-film section (DESIGN 9)."""
+    L = ["## Squeeze-film factor phi (from the engagement transients)", "",
+         "The torque of eq. 8 on the squeeze-film state (F_app = F_c(h_bar) + 3 pi phi mu_v K / (2 h_bar^3)"
+         f" (-dh_bar/dt), K = {f['reynolds_factor_m4']:.5g} m^4), driven by the load cell, the slip and the observer"
+         f" temperature, fitted to the measured torque from contact to contact + 0.3 s ({f['samples']} samples,"
+         f" {f['substeps']} substeps per period): phi = {phi:.5g} ({f['ci_method']}).", "",
+         f"Torque RMSE over the transients: {f['rmse_Nm']:.2f} Nm with the film state, {f['rmse_steady_Nm']:.2f} Nm"
+         " with the steady film (eq. 16).", "",
+         "| run | samples | largest transient error, steady (Nm) | with the film state (Nm) |", "|---|---|---|---|"]
+    for r in f["runs"]:
+        L.append(f"| {r['id']} | {r['samples']} | {r['transient_max_error_steady_Nm']:.1f} |"
+                 f" {r['transient_max_error_film_Nm']:.1f} |")
+    return L + [""]
+
+
+def _md_static(f: dict, factor: float) -> list[str]:
+    """The static friction section (DESIGN 9)."""
+    L = ["## Static friction factor (from the breakaway runs)", "",
+         "At breakaway the shaft torque equals the static capacity k_static mu_f(0, theta) R_eff N_c F_c; the torque"
+         " is read on a line through the ramp's last 60 ms before it drops to the kinetic torque (the noisy maximum"
+         " would be biased up)."
+         f" k_static = {factor:.5g} ({f['ci_method']}; spread {f['spread_rel'] * 100:.2f} %).", "",
+         "| run | force (N) | theta (degC) | torque at breakaway (Nm) | ramp (Nm/s) | k_static |", "|---|---|---|---|---|---|"]
+    for r in f["runs"]:
+        L.append(f"| {r['id']} | {r['force_N']:.1f} | {r['theta_degC']:.1f} | {r['torque_Nm']:.2f} |"
+                 f" {r['ramp_Nm_s']:.1f} | {r['static_factor']:.5g} |")
+    return L + [""]
 
 
 def _md_exclusions(fig: dict) -> list[str]:

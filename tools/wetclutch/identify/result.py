@@ -12,6 +12,8 @@ WHAT = {
     "viscosity": "viscosity.csv, eq. 2 least squares",
     "asperity": "the viscous drag of the friction runs (flat-mu region, eq. 8, 9, 15)",
     "mu": "the friction runs, eq. 17 samples fitted with eq. 18",
+    "film": "the engagement runs' transient, the squeeze-film state (DESIGN 9) fitted to the torque",
+    "static": "the breakaway runs, the torque at breakaway over the static capacity (DESIGN 9)",
 }
 
 
