@@ -5,7 +5,8 @@ run against this simulator. It is deliberately richer than the control model
 (DESIGN 2), in double precision, vectorized over experiments (NumPy), seeded:
 
 - a TRUE parameter set (tools/calibrations/bench_true.toml, same schema as
-  table1.toml) that differs from Table 1 by a few percent;
+  table1.toml) that differs from Table 1 by a few percent, plus the
+  engagement edges Table 1 leaves out (squeeze factor, static friction);
 - the squeeze film by the Reynolds force balance (DESIGN 9), per friction
   interface F_app = F_c(h) + F_h: the asperities carry F_c = A_f p_c(h)
   (eq. 15) at the nominal separation h (the state), the oil squeezed out
@@ -72,12 +73,14 @@ Measurements (CSV_COLUMNS): slip from the encoder (noise 0.5 rpm), load cell
 slipping), clutch/oil/housing thermistors (0.15 s lag, 0.1 K).
 torque_request_Nm is what the TCU would be asked for: the measured torque
 through a 10 ms first-order filter, clipped at >= 0 (sent with Mode Open
-before contact, TorqueControl from contact on).
+before contact, TorqueControl from contact on; table2, thermal, breakaway:
+from the force step on).
 
 The simulation step is 1 ms. Every experiment writes a measurement CSV and,
 by default for the engagement only, the candump -L log of the frames the TCU
 receives (canlog.input_log / canlog.write_log, one period per ms); table2
-and thermal CSVs are decimated to 10 ms unless the logs are asked for.
+and thermal CSVs are decimated to 10 ms unless the logs are asked for
+(breakaway: 1 ms CSVs, logs if asked).
 
 The film is integrated by classical RK4 in BenchConfig.film_substeps = 2
 substeps of 0.5 ms per step, the actuator force exact within the step, the
@@ -86,16 +89,19 @@ viscosity held. Why 2 is enough: (1) stability: the largest
 N, during the force step; the engagement at 80 degC 350 1/s, the breakaway
 at 80 degC 400 1/s), i.e. 0.26 per substep against RK4's real-axis limit
 2.79; near contact it is 1/tau, and 2 substeps stay stable down to tau =
-0.18 ms, below the 0.29 ms of the hottest oil the firmware accepts (250
-degC), so no bench state can make the film ring or diverge; (2) accuracy:
+0.18 ms, below the settled film's 0.29 ms in the hottest oil the firmware
+accepts (250 degC): the settled film cannot ring anywhere in the thermal
+envelope; (2) accuracy:
 against 32 substeps, 2 give engagement torques within 3.4e-5 Nm and contact
 forces within 3e-4 N (1.5e-3 N in table2's hottest force step), and 4 change
 the engagement torque by less than 3.4e-5 Nm (test_film_substeps_converged).
 A step that leaves h and the actuator force unchanged to the last bit (the
 film settled under a constant force) is not integrated again until the
 command changes: the viscosity, the one input that still changes, does not
-move an equilibrium. The table2 campaign takes about as long as with the
-first-order film before (see tests/python/test_bench.py).
+move an equilibrium. Cost (2 cores, NumPy; the first-order film before in
+brackets): the table2 campaign 14.5-15.2 s (14.4-15.5 s), the thermal runs
+51 s (62 s), the three 40 degC engagements 1.4 s (0.8 s: the film is
+integrated for about a second of each), the six breakaway runs 2.9 s.
 
 Noise: one generator per experiment, seeded from (seed, crc32(name)), drawn
 in blocks of NOISE_BLOCK steps, so an experiment gives the same numbers alone
