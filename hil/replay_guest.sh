@@ -4,6 +4,7 @@
 # started by hil/vcan_run.sh):
 #   bash hil/replay_guest.sh LOG OUTDIR [--iface vcan0] [--log-iface NAME]
 #                            [--frame-runs N] [--timer-runs N] [--tcu PATH] [--calibration NAME] [--bench]
+#                            [--theta-start DEGC]
 # Each run: candump -L captures the bus, wc_tcu runs (frame clock: one step per
 # ClutchSensors frame; timer clock: fixed period), canplayer plays LOG with its
 # timing, wc_tcu stops when the bus has been idle for 1 s. Output per run:
@@ -11,10 +12,10 @@
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 die() { echo "replay_guest: $*" >&2; exit 2; }
-[ $# -ge 2 ] || die "usage: $0 LOG OUTDIR [--iface vcan0] [--log-iface NAME] [--frame-runs N] [--timer-runs N] [--tcu PATH] [--calibration NAME] [--bench]"
+[ $# -ge 2 ] || die "usage: $0 LOG OUTDIR [--iface vcan0] [--log-iface NAME] [--frame-runs N] [--timer-runs N] [--tcu PATH] [--calibration NAME] [--bench] [--theta-start DEGC]"
 log=$1 out=$2; shift 2
 iface=vcan0 log_iface="" frame_runs=2 timer_runs=1 tcu="$repo/build/host-release/src/port/wc_tcu" calibration=table1
-bench=()
+bench=() theta=()
 while [ $# -gt 0 ]; do
   case $1 in
     --iface) iface=$2; shift 2 ;;
@@ -24,6 +25,7 @@ while [ $# -gt 0 ]; do
     --tcu) tcu=$2; shift 2 ;;
     --calibration) calibration=$2; shift 2 ;;
     --bench) bench=(--bench); shift ;;   # wc_tcu uses BenchMeasurement (the paper's validation)
+    --theta-start) theta=(--theta-start "$2"); shift 2 ;;   # the observer's start (the log's first oil temperature)
     *) die "unknown option '$1'" ;;
   esac
 done
@@ -38,7 +40,7 @@ one_run() { # clock name
   local clock=$1 name=$2 dump_pid tcu_pid rc=0
   candump -L -r 8388608 "$iface" >"$out/$name.log" &
   dump_pid=$!
-  "$tcu" --iface "$iface" --clock "$clock" --calibration "$calibration" "${bench[@]}" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
+  "$tcu" --iface "$iface" --clock "$clock" --calibration "$calibration" "${bench[@]}" "${theta[@]}" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
   tcu_pid=$!
   for _ in $(seq 100); do grep -q "clock $clock" "$out/$name.txt" 2>/dev/null && break; sleep 0.05; done
   grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill $dump_pid $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }

@@ -51,17 +51,22 @@ int main(int argc, char **argv)
     const char *log_path = NULL;
     const char *calibration = "table1";
     int bench = 0;
+    double theta_start_degC = 40.0;  /* as wc_tcu --theta-start */
     for (int i = 1; i < argc; ++i) {
+        char *end = NULL;
         if (strcmp(argv[i], "--bench") == 0) { bench = 1; }
         else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; }
+        else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
+                 ((void)(theta_start_degC = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0')) &&
+                 (theta_start_degC >= -40.0) && (theta_start_degC <= 250.0)) { ++i; }
         else if ((argv[i][0] != '-') && (log_path == NULL)) { log_path = argv[i]; }
         else {
-            fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME]\n");
+            fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]\n");
             return 2;
         }
     }
     if (log_path == NULL) {
-        fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME]\n");
+        fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]\n");
         return 2;
     }
     const wc_calibration_t *cal = NULL;
@@ -75,7 +80,7 @@ int main(int argc, char **argv)
     static wc_loop_t loop;  /* large (receive ring): static storage */
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     config.bench_input_enabled = bench != 0;
-    if (wc_loop_init(&loop, cal, &config, 40.0f) != WC_CAL_OK) {
+    if (wc_loop_init(&loop, cal, &config, (float)theta_start_degC) != WC_CAL_OK) {
         fprintf(stderr, "wc_replay: calibration %s rejected\n", calibration);
         return 2;
     }

@@ -18,7 +18,7 @@ def assert_frames_match_reference(ref: dict, frames: dict, steps: int | None = N
     assert ref["steps"] == n and len(cmd["VfsCurrent"]) == n and len(est["ModelTorque"]) == n
     # Tolerance: half a raw step of the signal (the encoder rounds to nearest)
     # plus the float32 model against the double reference (1e-4 relative:
-    # LUT error 3.9e-5, inverse tolerance 0.01 N, observer float rounding).
+    # LUT error 3.9e-5, inverse tolerance 0.01 N, observer float rounding; the film below).
     checks = [
         ("VfsCurrent", cmd["VfsCurrent"], ref["current_mA"], _half_step(canlog.COMMAND, "VfsCurrent")),
         ("PressureCommand", cmd["PressureCommand"], ref["pressure_command_Pa"] * 1e-3,
@@ -29,8 +29,12 @@ def assert_frames_match_reference(ref: dict, frames: dict, steps: int | None = N
         ("MuF", est["MuF"], ref["mu_f"], _half_step(canlog.ESTIMATE, "MuF")),
         ("FilmThickness", est["FilmThickness"], ref["hbar_m"] * 1e6, _half_step(canlog.ESTIMATE, "FilmThickness")),
     ]
+    # With the squeeze-film state on (DESIGN 9) the torque and the film carry its float table inverse and
+    # secant step against the reference's exact eq. 9/15: 1e-3 relative (tests/c/test_clutch.c, engagement edges).
+    film_rel = 1e-3 if ref.get("film_state") else 1e-4
     for name, got, want, half in checks:
-        excess = np.abs(got - want) - (half * 1.0001 + 1e-4 * np.abs(want))
+        rel = film_rel if name in ("ModelTorque", "FilmThickness") else 1e-4
+        excess = np.abs(got - want) - (half * 1.0001 + rel * np.abs(want))
         k = int(np.argmax(excess))
         assert excess[k] <= 0.0, f"{name}: worst at step {k}: {got[k]} vs {want[k]}"
     # The lock-up state (DESIGN 9) in both frames.

@@ -38,7 +38,9 @@ def wc_replay() -> Path:
 
 def run_inproc(exe: Path, log: Path, tmp_path: Path, bench: bool = True) -> list:
     out = tmp_path / (log.stem + ".out.log")
-    args = [str(exe), str(log), "--calibration", "bench_identified"] + (["--bench"] if bench else [])
+    theta = replay.theta_start_degC_of(canlog.read_log(log))   # as wetclutch replay passes wc_tcu
+    args = [str(exe), str(log), "--calibration", "bench_identified", "--theta-start", f"{theta:.1f}"] + (
+        ["--bench"] if bench else [])
     proc = subprocess.run(args, capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     out.write_text(proc.stdout)
@@ -51,7 +53,8 @@ def check_against_reference(frames, log_messages, bench: bool = True) -> None:
     assert_frames_match_reference(ref, replay.output_frames(frames))
 
 
-@pytest.mark.parametrize("name", ["engagement_750rpm", "engagement_500rpm", "engagement_250rpm"])
+@pytest.mark.parametrize("name", ["engagement_750rpm", "engagement_500rpm", "engagement_250rpm",
+                                  "engagement_750rpm_80degC", "engagement_500rpm_80degC", "engagement_250rpm_80degC"])
 def test_bundled_logs_match_reference(wc_replay, tmp_path, name):
     log = LOGS / f"{name}.log"
     frames = run_inproc(wc_replay, log, tmp_path)

@@ -104,9 +104,11 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
         job_out = Path(job_out).resolve()
         job_out.mkdir(parents=True, exist_ok=True)
         rw += ["--rwdir", str(job_out)]
+        theta = theta_start_degC_of(canlog.read_log(job_log))
         script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
                                   str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
-                                  "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else [])]))
+                                  "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else []),
+                                  "--theta-start", f"{theta:.1f}"]))
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
@@ -116,6 +118,20 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
 
 
 # --------------------------------------------------------------------------- reference of the loop
+
+DEFAULT_THETA_START_DEGC = 40.0   # wc_tcu --theta-start's default
+
+
+def theta_start_degC_of(messages) -> float:
+    """Where the observer starts for a log: its first ClutchSensors oil temperature to 0.1 degC (a pack
+    soaked at oil temperature; wc_tcu/wc_replay --theta-start), else wc_tcu's default."""
+    spec = canlog.database().get_message_by_name(canlog.SENSORS)
+    for m in messages:
+        if m.arbitration_id == spec.frame_id and not m.is_extended_id and len(m.data) == spec.length:
+            oil = float(spec.decode(bytes(m.data), decode_choices=False)["OilTemp"])
+            if -40.0 <= oil <= 200.0:
+                return round(oil, 1)
+    return DEFAULT_THETA_START_DEGC
 
 @dataclass
 class _Input:
@@ -174,11 +190,13 @@ class _Input:
         return stale, timed_out
 
 
-def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
+def loop_reference(cal: Calibration, messages, theta_start: float | None = None,
                    sensor_timeout: int = 10, request_timeout: int = 10, recovery_periods: int = 20,
                    bench: bool = True) -> dict:
     """What wc_tcu --clock frame [--bench] computes for this sequence of received frames
-    (WC_LOOP_CONFIG_DEFAULT: MaxDeltaCounter 2, SyncCounter 3, recovery 20 periods)."""
+    (WC_LOOP_CONFIG_DEFAULT: MaxDeltaCounter 2, SyncCounter 3, recovery 20 periods). theta_start: wc_tcu's
+    --theta-start (default: the log's, theta_start_degC_of)."""
+    theta_start_degC = theta_start_degC_of(messages) if theta_start is None else float(theta_start)
     db = canlog.database()
     names = RX_NAMES if bench else tuple(n for n in RX_NAMES if n != canlog.BENCH)  # wc_tcu's kernel filter
     specs = {db.get_message_by_name(n).frame_id: db.get_message_by_name(n) for n in names}
@@ -263,7 +281,7 @@ def loop_reference(cal: Calibration, messages, theta_start_degC: float = 40.0,
     bits |= np.where(status & model.STATUS_BELOW_DRAG, BIT["StatusBelowDrag"], 0)
     bits |= np.where(status & model.STATUS_OVER_TEMPERATURE, BIT["StatusOverTemperature"], 0)
     bits |= np.where(status & model.STATUS_LOCKED, BIT["StatusLocked"], 0)
-    return {"steps": len(rows), "rejected": rejected, "slip_rpm": slip, "theta_oil_degC": oil,
+    return {"steps": len(rows), "rejected": rejected, "film_state": cal.film_squeeze_factor > 0.0, "slip_rpm": slip, "theta_oil_degC": oil,
             "bench_force_N": load, "bench_torque_Nm": measured_torque,
             "theta_housing_degC": housing, "torque_request_Nm": request, "mode": mode, "status_bits": bits, **steps}
 
