@@ -1,6 +1,8 @@
 """The HIL replay of the bundled engagement logs (paper Fig. 15) on vcan: the
-targets of the HIL issue, checked by the same command as the README's main job.
-One vcan session (one VM boot where the kernel has no CAN) for all three logs."""
+targets of the HIL issue and of the engagement edges (issue 12: transient error
+with the squeeze-film state, a locked estimate of stable sign within the static
+capacity), checked by the same command as the README's main job. One vcan
+session (one VM boot where the kernel has no CAN) for all six logs (40 and 80 degC)."""
 from __future__ import annotations
 
 import json
@@ -10,7 +12,8 @@ import sys
 
 import pytest
 
-LOGS = ("engagement_750rpm", "engagement_500rpm", "engagement_250rpm")
+LOGS = ("engagement_750rpm", "engagement_500rpm", "engagement_250rpm",
+        "engagement_750rpm_80degC", "engagement_500rpm_80degC", "engagement_250rpm_80degC")
 
 
 @pytest.fixture(scope="module")
@@ -39,6 +42,10 @@ def test_replay_report(replayed, name):
     assert m["frames_dropped"] == 0
     assert m["deterministic_frame_clock"]
     assert m["tcu_vs_reference_max_abs"]["status_mismatches"] == 0
+    # issue 12: the squeeze-film state and the lock-up
+    assert m["torque_max_abs_error_transient_Nm"] <= 28.9 < m["torque_max_abs_error_transient_steady_model_Nm"]
+    assert m["locked"]["sign_changes"] == 0 and m["locked"]["locked_samples"] > 100
+    assert m["locked"]["max_abs_over_capacity_Nm"] <= 0.1
     for png in ("torque.png", "temperature.png", "command.png", "status.png"):
         assert (out / name / png).stat().st_size > 1000
     assert "paper" in (out / name / "summary.md").read_text()

@@ -1,4 +1,4 @@
-"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay}``."""
+"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay,film-study}``."""
 from __future__ import annotations
 
 import argparse
@@ -155,6 +155,18 @@ _SKIPPED = {"error": "error frame(s)", "remote": "remote frame(s)", "fd": "CAN F
             "event": "non-CAN event line(s)"}
 
 
+def _cmd_film_study(args) -> int:
+    from . import film_study  # the bench simulator only when needed
+    res = film_study.run(Path(args.out), model_path=args.calibration, true_path=args.true, seed=args.seed)
+    print(film_study.markdown(res))
+    print(f"wrote {args.out}/film_study.md, film_study.json")
+    if not res["all_met"]:
+        missed = [r for r in res["cases"] if not r["met"]]
+        print(f"wetclutch film-study: {len(missed)} case(s) below the ratio {res['ratio_target']:g}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _cmd_convert(args) -> int:
     from . import bench
     stats = bench.convert_log(args.input, args.output, channel=args.channel)
@@ -206,6 +218,15 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--no-reference-check", action="store_true",
                    help="skip comparing every TCU step with the double-precision reference")
     q.set_defaults(func=_cmd_replay)
+
+    q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
+                                          " identified on two engagements, tested on 12 others per plant")
+    q.add_argument("--out", default="out/film_study", help="output directory (default out/film_study)")
+    q.add_argument("--calibration", "-c", default="tools/calibrations/bench_identified.toml",
+                   help="the model's calibration (its phi is re-identified per plant)")
+    q.add_argument("--true", default="tools/calibrations/bench_true.toml", help="the bench's true parameters")
+    q.add_argument("--seed", default=1, type=int, help="bench noise seed (default 1)")
+    q.set_defaults(func=_cmd_film_study)
 
     q = sub.add_parser("identify", help="identify mu_f, k1/k2, viscosity, asperity density from bench data")
     q.add_argument("step", choices=["mu", "thermal", "viscosity", "asperity", "film", "static", "all"])
