@@ -159,7 +159,7 @@ ACCEPTED = c_variants("accepted_variants")
 def test_variant_lists_parsed():
     assert len(REJECTED) >= 70 and len(ACCEPTED) >= 35
     fields = {f for _, settings in REJECTED for f, _ in settings}
-    assert len(fields) == 23      # every float field of wc_calibration_t has a rejected variant
+    assert len(fields) == 28      # every float field of wc_calibration_t has a rejected variant
 
 
 def _label(settings):
@@ -178,7 +178,7 @@ def test_rejected_like_the_firmware(tmp_path, code, settings):
         return
     assert firmware_names()[code] in message, message      # the firmware's name of the failing check
     assert str(path) in message
-    assert re.search(r"'(geometry|thermal|viscosity|friction|contact|hydraulics|control|film_lut)\.\w+'", message)
+    assert re.search(r"'(geometry|thermal|viscosity|friction|contact|hydraulics|control|engagement|film_lut)\.\w+'", message)
     if len(settings) == 1 and code not in ("WC_CAL_FRICTION_DOMAIN", "WC_CAL_VISCOSITY_RANGE",
                                            "WC_CAL_THERMAL_TIME_CONSTANT", "WC_CAL_FILM_COVERAGE",
                                            "WC_CAL_VFS_CURRENT_MAX", "WC_CAL_INNER_RADIUS",

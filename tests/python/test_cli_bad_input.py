@@ -370,7 +370,7 @@ def fake_capture(run_dir: Path, log: Path) -> None:
         frames.append((k * 1e-3, enc.frame(canlog.COMMAND, VfsCurrent=100.0, PressureCommand=200.0, **status)))
         frames.append((k * 1e-3 + 1e-6, enc.frame(canlog.ESTIMATE, EstimatedClutchTemp=40.0, MuF=0.13,
                                                   ModelTorque=float(torque[min(k, torque.size - 1)]),
-                                                  FilmThickness=5.0)))
+                                                  FilmThickness=5.0, LockState=0)))
     run_dir.mkdir(parents=True)
     canlog.write_log(run_dir / "frame1.log", frames)
     (run_dir / "frame1.json").write_text(json.dumps({

@@ -46,10 +46,10 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
     "StatusCounterError", "StatusImplausibleInput", "StatusSaturated",
     "StatusCurrentClamped", "StatusBelowDrag", "StatusSafeStateActive",
     "StatusDeadlineMiss", "StatusOverTemperature", "StatusBenchInput",
-    "StatusFrameLost", "StatusBusError",
+    "StatusFrameLost", "StatusBusError", "StatusLocked",
 ]
 # Integer signals that the scaling wrapper does not convert.
-UNSCALED = {"Crc", "AliveCounter", "Mode", *STATUS_BITS}
+UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", *STATUS_BITS}
 
 
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
@@ -261,7 +261,7 @@ int main(int argc, char **argv) {
             wc_can_vfs_command_phys_t p = {F(v[0]), F(v[1]), (uint16_t)U(v[2]), (uint8_t)U(v[3])};
             r = (int)wc_can_encode_vfs_command(f, &p, 8);
         } else if (!strcmp(m, "ClutchEstimate")) {
-            wc_can_clutch_estimate_phys_t p = {F(v[0]), F(v[1]), F(v[2]), F(v[3])};
+            wc_can_clutch_estimate_phys_t p = {F(v[0]), F(v[1]), F(v[2]), F(v[3]), (uint8_t)U(v[4])};
             r = (int)wc_can_encode_clutch_estimate(f, &p, 8);
         } else if (!strcmp(m, "BenchMeasurement")) {
             wc_can_bench_measurement_phys_t p = {F(v[0]), F(v[1]), F(v[2])};
@@ -292,8 +292,8 @@ int main(int argc, char **argv) {
         } else if (!strcmp(m, "ClutchEstimate")) {
             wc_can_clutch_estimate_phys_t p;
             r = (int)wc_can_decode_clutch_estimate(&p, f, 8);
-            printf("%d %.9g %.9g %.9g %.9g\n", r, (double)p.estimated_clutch_temp_degC,
-                   (double)p.model_torque_Nm, (double)p.mu_f, (double)p.film_thickness_um);
+            printf("%d %.9g %.9g %.9g %.9g %u\n", r, (double)p.estimated_clutch_temp_degC,
+                   (double)p.model_torque_Nm, (double)p.mu_f, (double)p.film_thickness_um, p.lock_state);
         } else if (!strcmp(m, "BenchMeasurement")) {
             wc_can_bench_measurement_phys_t p;
             r = (int)wc_can_decode_bench_measurement(&p, f, 8);
@@ -387,8 +387,8 @@ CASES = {
                     **{b: (0x0235 >> n) & 1 for n, b in enumerate(STATUS_BITS)},
                     "AliveCounter": 6}, ["VfsCurrent", "PressureCommand", "Status", "AliveCounter"]),
     "ClutchEstimate": ({"EstimatedClutchTemp": 146.93, "ModelTorque": -154.66,
-                        "MuF": 0.0904345, "FilmThickness": 4.34249},
-                       ["EstimatedClutchTemp", "ModelTorque", "MuF", "FilmThickness"]),
+                        "MuF": 0.0904345, "FilmThickness": 4.34249, "LockState": 1},
+                       ["EstimatedClutchTemp", "ModelTorque", "MuF", "FilmThickness", "LockState"]),
     "BenchMeasurement": ({"LoadCellForce": -1188.04, "MeasuredTorque": 194.613,
                           "ClutchThermistorTemp": 88.88},
                          ["LoadCellForce", "MeasuredTorque", "ClutchThermistorTemp"]),
@@ -400,7 +400,7 @@ def _c_args(values, order):
     for key in order:
         if key == "Status":
             args.append(sum(values[b] << n for n, b in enumerate(STATUS_BITS)))
-        elif key in ("Mode", "AliveCounter"):
+        elif key in ("Mode", "AliveCounter", "LockState"):
             args.append(values[key])
         else:
             args.append(repr(f32(values[key])))
@@ -433,7 +433,7 @@ def test_c_encoder_matches_cantools(db, helper, name):
     for key, text in zip(order, c_out[1:]):
         if key == "Status":
             assert int(text) == sum(values[b] << n for n, b in enumerate(STATUS_BITS))
-        elif key in ("Mode", "AliveCounter"):
+        elif key in ("Mode", "AliveCounter", "LockState"):
             assert int(text) == values[key]
         else:
             sig = msg.get_signal_by_name(key)
