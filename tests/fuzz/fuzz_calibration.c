@@ -11,7 +11,7 @@
  *           that many floats so that AddressSanitizer sees any read past the
  *           end; bits 3-4 == 3: one of the three pointers NULL (bits 5-6).
  *   then edits until the bytes run out (at most MAX_EDITS): a target byte
- *   (one of the 23 float fields, friction_pairs, or a node of the film's
+ *   (one of the 28 float fields, friction_pairs, or a node of the film's
  *   pressure / h_bar / slope array, index in one more byte) and a mutation
  *   (raw float bits, a special or in-range value, a factor 2^(k/8), a
  *   perturbation by up to 3 %, a negation, some ulps up or down).
@@ -83,6 +83,8 @@ static const float_field_t float_fields[] = {
     FIELD(mu1), FIELD(mu2), FIELD(mu3), FIELD(stribeck_speed_m_s), FIELD(theta1_degC), FIELD(theta2_K),
     FIELD(vfs_gain_Pa_per_mA), FIELD(vfs_time_constant_s), FIELD(return_spring_force_N),
     FIELD(vfs_current_min_mA), FIELD(vfs_current_max_mA), FIELD(control_period_s),
+    FIELD(film_squeeze_factor), FIELD(static_friction_factor), FIELD(lock_slip_rad_s), FIELD(breakaway_slip_rad_s),
+    FIELD(holding_margin),
 };
 #undef FIELD
 #define N_FLOAT_FIELDS (sizeof float_fields / sizeof float_fields[0])
@@ -141,8 +143,12 @@ static void evaluate(const wc_calibration_t *c)
     fz_context("wc_model_init(accepted calibration)", 0u);
     FZ_CHECK(wc_model_init(&model, c) == WC_CAL_OK, "wc_model_init rejects what wc_calibration_check accepted");
     FZ_CHECK(fz_finite(model.effective_radius_m) && (model.effective_radius_m > 0.0f) &&
-                 fz_finite((model.effective_radius_m * (float)model.cal->friction_pairs)) && ((model.effective_radius_m * (float)model.cal->friction_pairs) > 0.0f),
-             "R_eff %g, R_eff N_c %g", (double)model.effective_radius_m, (double)(model.effective_radius_m * (float)model.cal->friction_pairs));
+                 fz_finite(model.effective_radius_m * (float)model.cal->friction_pairs),
+             "R_eff %g, R_eff N_c %g", (double)model.effective_radius_m,
+             (double)(model.effective_radius_m * (float)model.cal->friction_pairs));
+    FZ_CHECK(fz_finite(model.film_damping_m4) && (model.film_damping_m4 >= 0.0f) &&
+                 ((model.film_damping_m4 > 0.0f) == (c->film_squeeze_factor > 0.0f)),
+             "squeeze-film damping %g m^4 for phi %g", (double)model.film_damping_m4, (double)c->film_squeeze_factor);
     FZ_CHECK(fz_finite(model.force_max_N) && in_range(model.force_max_N, 0.0f, WC_FORCE_MAX_N),
              "F_max %g outside [0, %g]", (double)model.force_max_N, (double)WC_FORCE_MAX_N);
     FZ_CHECK(fz_finite(model.hbar_at_force_max_m) && (model.hbar_at_force_max_m > 0.0f), "h_bar(F_max) %g",

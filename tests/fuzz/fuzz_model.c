@@ -57,6 +57,7 @@ static bool strict;
 static float hbar_min_m;
 static float hbar_max_m;
 static float torque_bound_Nm;  /* mu_f 1 at WC_FORCE_MAX_N plus the largest viscous torque */
+static float torque_arm_m;     /* R_eff N_c */
 
 static bool in_range(float x, float lo, float hi) { return (x >= lo) && (x <= hi); }
 static bool slip_ok(float x) { return in_range(x, -WC_SLIP_MAX_rad_s, WC_SLIP_MAX_rad_s); }
@@ -95,15 +96,16 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     /* mu_v falls with theta for table1 (both exponents negative): largest at -40 degC. */
     const float mu_v_max = fmaxf(wc_viscosity_Pa_s(cal, WC_THETA_MIN_degC), wc_viscosity_Pa_s(cal, WC_THETA_MAX_degC));
     const float v_max = model.effective_radius_m * WC_SLIP_MAX_rad_s;
-    torque_bound_Nm = 1.01f * ((model.effective_radius_m * (float)model.cal->friction_pairs) * WC_FORCE_MAX_N +
-                               (model.effective_radius_m * (float)model.cal->friction_pairs) * mu_v_max * cal->friction_area_m2 * v_max / hbar_min_m);
+    torque_arm_m = model.effective_radius_m * (float)cal->friction_pairs;
+    torque_bound_Nm = 1.01f * (torque_arm_m * WC_FORCE_MAX_N +
+                               torque_arm_m * mu_v_max * cal->friction_area_m2 * v_max / hbar_min_m);
     if (!fz_finite(torque_bound_Nm)) {
         fprintf(stderr, "fuzz_model: torque bound %g not finite\n", (double)torque_bound_Nm);
         abort();
     }
     if (fz_env_flag("WC_FUZZ_VERBOSE")) {
         fprintf(stderr, "fuzz_model: |T| bound %g Nm (Coulomb %g at mu_f 1, viscous at mu_v %g Pa s, h_bar %g m)\n",
-                (double)torque_bound_Nm, (double)((model.effective_radius_m * (float)model.cal->friction_pairs) * WC_FORCE_MAX_N), (double)mu_v_max,
+                (double)torque_bound_Nm, (double)(torque_arm_m * WC_FORCE_MAX_N), (double)mu_v_max,
                 (double)hbar_min_m);
     }
     return 0;
@@ -143,9 +145,9 @@ static void check_torque_output(const wc_torque_t *t, float slip_rad_s, bool rej
     } else {
         FZ_CHECK((t->mu_f > 0.0f) && (t->mu_f <= 1.0f), "mu_f %g outside (0, 1]", (double)t->mu_f);
         /* Coulomb part: mu_f F R_eff N_c exactly (eq. 6), up to rounding. */
-        FZ_CHECK(close_rel(fabsf(t->coulomb_Nm), t->mu_f * force_N * (model.effective_radius_m * (float)model.cal->friction_pairs), 1e-5f, 1e-6f),
+        FZ_CHECK(close_rel(fabsf(t->coulomb_Nm), t->mu_f * force_N * torque_arm_m, 1e-5f, 1e-6f),
                  "|Tc| %g != mu_f %g * F %g * R_eff N_c %g", (double)t->coulomb_Nm, (double)t->mu_f, (double)force_N,
-                 (double)(model.effective_radius_m * (float)model.cal->friction_pairs));
+                 (double)torque_arm_m);
     }
 }
 

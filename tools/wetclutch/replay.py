@@ -99,16 +99,18 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
         raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
                                 " cmake --build --preset host-release)")
     script = []
-    rw = []
+    shared = []   # one writable share per output parent: every share is on the guest kernel's command line
     for job_log, job_out in jobs:
         job_out = Path(job_out).resolve()
         job_out.mkdir(parents=True, exist_ok=True)
-        rw += ["--rwdir", str(job_out)]
+        if job_out.parent not in shared:
+            shared.append(job_out.parent)
         theta = theta_start_degC_of(canlog.read_log(job_log))
         script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
                                   str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
                                   "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else []),
                                   "--theta-start", f"{theta:.1f}"]))
+    rw = [arg for d in shared for arg in ("--rwdir", str(d))]
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
