@@ -153,12 +153,14 @@ def test_bundled_logs_regenerate(root, tmp_path):
     assert r.returncode == 0, r.stderr
     names = ("engagement_750rpm.log", "engagement_750rpm.csv", "engagement_750rpm_80degC.log",
              "engagement_750rpm_80degC.csv")
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names + ("engagement_index.csv",))
     for name in names:
         assert (tmp_path / name).read_bytes() == (root / "hil" / "logs" / name).read_bytes(), name
     readme = (root / "hil" / "logs" / "README.md").read_text()
     assert "--out hil/logs --seed 1" in readme
-    bundled = sorted(p.name for p in (root / "hil" / "logs").iterdir() if p.suffix in (".log", ".csv"))
+    bundled = sorted(p.name for p in (root / "hil" / "logs").iterdir()
+                     if p.suffix in (".log", ".csv") and not p.name.endswith("_index.csv"))
+    assert (root / "hil" / "logs" / "engagement_index.csv").is_file()   # identify film finds the runs by it
     assert len(bundled) == 12 and all(f"`{name[:-4]}.log`" in readme for name in bundled)
 
 

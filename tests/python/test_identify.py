@@ -505,3 +505,29 @@ def test_full_campaign():
     assert fig["mu"]["experiments"] == 184
     assert all(fig["targets"].values()), fig["targets"]
     assert fig["runtime_s"]["total"] < 60.0
+
+
+def test_identify_engagement_edges_from_the_bench(tmp_path):
+    """issue 12: `identify film` on engagement runs and `identify static` on breakaway runs, as the bench
+    writes them (their index CSVs), recover the bench's phi and static factor within 5 %; the film state
+    cuts the transient error several-fold."""
+    from wetclutch import bench as bench_sim
+    data = tmp_path / "data"
+    bench_sim.run("engagement", data / "engagement", slips_rpm=[750.0], logs=False)
+    bench_sim.run("breakaway", data / "breakaway")
+    true = calibration.load(bench_sim.DEFAULT_TRUE)
+    cal = ROOT / "tools" / "calibrations" / "bench_identified.toml"
+    for step, name in (("film", "film_squeeze_factor"), ("static", "static_friction_factor")):
+        out = tmp_path / step
+        r = subprocess.run([sys.executable, "-m", "wetclutch.cli", "identify", step, str(data), "--calibration",
+                            str(cal), "--out", str(out), "--true", str(bench_sim.DEFAULT_TRUE)],
+                           capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT / "tools")})
+        assert r.returncode == 0, r.stderr
+        fig = identify.json.loads((out / "figures.json").read_text())
+        p = fig["parameters"][name]
+        assert abs(p["identified"] / getattr(true, name) - 1.0) <= 0.05 and p["within_5pct"], p
+        assert 0 < p["ci95"] < 0.05 * p["identified"]
+        assert calibration.load(out / "calibration.toml").values[name] == pytest.approx(p["identified"], rel=1e-6)
+    film = identify.json.loads((tmp_path / "film" / "figures.json").read_text())["film"]
+    for run in film["runs"]:
+        assert run["transient_max_error_film_Nm"] * 3.0 < run["transient_max_error_steady_Nm"], run

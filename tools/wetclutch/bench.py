@@ -815,6 +815,16 @@ def write_index(path: Path, cal: Calibration, results: list[Result]) -> None:
     atomic.write_text(path, "\n".join(lines) + "\n")
 
 
+def write_engagement_index(path: Path, cal: Calibration, results: list[Result]) -> None:
+    """The engagement runs' index: `wetclutch identify film` finds them by it (a campaign named engagement)."""
+    lines = ["id,force_N,pressure_kPa,slip_rpm,theta0_degC,file"]
+    for r in results:
+        e = r.experiment
+        lines.append(f"{e.id},{e.force_N:.1f},{e.force_N / cal.friction_area * 1e-3:.1f},{e.slip_rpm:g},"
+                     f"{e.theta0_degC:g},{e.name}.csv")
+    atomic.write_text(path, "\n".join(lines) + "\n")
+
+
 def write_breakaway_index(path: Path, cal: Calibration, results: list[Result]) -> None:
     lines = ["id,force_N,pressure_kPa,theta0_degC,file"]
     for r in results:
@@ -889,6 +899,10 @@ def run(kind: str, out_dir, true_path=DEFAULT_TRUE, seed=DEFAULT_SEED, slips_rpm
         if kind == "breakaway":
             path = out / "breakaway_index.csv"
             write_breakaway_index(path, true_cal, results)
+            files.append(path)
+        if kind == "engagement":
+            path = out / "engagement_index.csv"
+            write_engagement_index(path, true_cal, results)
             files.append(path)
     return {"files": files, "results": results}
 
