@@ -279,7 +279,17 @@ static void evaluate(const wc_calibration_t *c)
                     FZ_CHECK(fz_finite(clutch.theta_degC) &&
                                  in_range(clutch.theta_degC, WC_THETA_MIN_degC, WC_THETA_MAX_degC),
                              "estimate %g outside the envelope", (double)clutch.theta_degC);
-                    check_torque(&out.model, clutch.held.slip_rad_s, "wc_clutch_step");
+                    /* inside the lock band the torque keeps the lock direction (DESIGN 9); locked, it is
+                     * the held torque, within the static capacity */
+                    const float slip = clutch.held.slip_rad_s;
+                    const float direction = (clutch.lockup.direction < 0) ? -1.0f : 1.0f;
+                    check_torque(&out.model, (fabsf(slip) < c->lock_slip_rad_s) ? direction * fmaxf(fabsf(slip), FLT_MIN)
+                                                                              : slip, "wc_clutch_step");
+                    FZ_CHECK(fz_finite(out.static_capacity_Nm) && (out.static_capacity_Nm >= 0.0f) &&
+                                 (((out.status & WC_STATUS_LOCKED) == 0u) ||
+                                  (fabsf(out.model.torque_Nm) <= out.static_capacity_Nm)),
+                             "wc_clutch_step: static capacity %g, torque %g, status 0x%x",
+                             (double)out.static_capacity_Nm, (double)out.model.torque_Nm, (unsigned)out.status);
                 }
             }
         }

@@ -191,7 +191,7 @@ static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES]
     wc_can_vfs_command_phys_t cmd;
     const wc_can_result_t rc = wc_can_decode_vfs_command(&cmd, out[0].data, out[0].dlc);
     FZ_CHECK(!wc_can_is_error(rc), "VfsCommand does not decode: result %d", (int)rc);
-    FZ_CHECK((out[0].data[7] & 0xC0u) == 0u, "reserved status bits set: byte 7 = 0x%02x", (unsigned)out[0].data[7]);
+    FZ_CHECK((out[0].data[7] & 0x80u) == 0u, "reserved status bit set: byte 7 = 0x%02x", (unsigned)out[0].data[7]);
     if (h->have_tx) {
         FZ_CHECK(cmd.alive_counter == (uint8_t)((h->tx_alive + 1u) % 16u), "tx alive counter %u after %u",
                  (unsigned)cmd.alive_counter, (unsigned)h->tx_alive);

@@ -49,7 +49,7 @@
 #define ALL_STATUS_BITS                                                                                  \
     (WC_STATUS_BELOW_DRAG | WC_STATUS_SATURATED | WC_STATUS_CURRENT_CLAMPED | WC_STATUS_SLIP_INVALID |   \
      WC_STATUS_THETA_INVALID | WC_STATUS_FORCE_INVALID | WC_STATUS_TORQUE_INVALID |                      \
-     WC_STATUS_POWER_INVALID | WC_STATUS_OVER_TEMPERATURE | WC_STATUS_NOT_INITIALISED)
+     WC_STATUS_POWER_INVALID | WC_STATUS_OVER_TEMPERATURE | WC_STATUS_NOT_INITIALISED | WC_STATUS_LOCKED)
 
 static const wc_calibration_t *const cal = &wc_table1_calibration;
 static wc_model_t model;
@@ -481,7 +481,22 @@ static void op_clutch_step(fz_reader_t *r, unsigned step)
     /* torque model: the force is the bench's when valid, else the modelled pressure's */
     const float force_used = (in.bench.valid && bench_force_ok) ? in.bench.apply_force_N
                                                                 : wc_contact_force_N(cal, clutch.pressure_model_Pa);
-    check_torque_output(&out.model, clutch.held.slip_rad_s, false, force_used);
+    FZ_CHECK(same_bits(out.contact_force_N, force_used), "contact force %g, the steady film's %g (film state off)",
+             (double)out.contact_force_N, (double)force_used);
+    FZ_CHECK(fz_finite(out.static_capacity_Nm) && (out.static_capacity_Nm >= 0.0f), "static capacity %g",
+             (double)out.static_capacity_Nm);
+    if ((out.status & WC_STATUS_LOCKED) != 0u) {   /* DESIGN 9: the held torque, within the capacity */
+        FZ_CHECK(fz_finite(out.model.torque_Nm) && (fabsf(out.model.torque_Nm) <= out.static_capacity_Nm) &&
+                     (out.model.torque_Nm * (float)clutch.lockup.direction >= 0.0f),
+                 "locked torque %g, capacity %g, direction %d", (double)out.model.torque_Nm,
+                 (double)out.static_capacity_Nm, (int)clutch.lockup.direction);
+        return;
+    }
+    /* inside the lock band the torque keeps the lock direction (the slip's sign there is noise) */
+    const float slip = clutch.held.slip_rad_s;
+    const float sign_slip = (fabsf(slip) < cal->lock_slip_rad_s)
+                                ? (float)clutch.lockup.direction * fmaxf(fabsf(slip), FLT_MIN) : slip;
+    check_torque_output(&out.model, sign_slip, false, force_used);
 }
 
 /* ------------------------------------------------------------------------ */
