@@ -31,7 +31,7 @@ static const wc_calibration_t wc_table1_calibration = {
     .vfs_current_max_mA = 1000.0f, /* mA; project default: solenoid range 0-1000 mA (issue 3) */
     .control_period_s = 0.001f, /* s; project default: 1 ms control period (DESIGN 4) */
     .film_squeeze_factor = 0.0f, /* 1; paper: steady film (eq. 16); 0 switches the film state off */
-    .static_friction_factor = 1.0f, /* 1; project default: static capacity = mu_f(0, theta) R_eff N_c F_c (the paper has no static friction, 3.5) */
+    .static_friction_factor = 1.2f, /* 1; project default: static friction 20 % above the kinetic at zero speed (paper linings: about 1.0-1.3; the paper has none, 3.5); above 1 + holding_margin / 2, so the force the inverse asks at zero slip locks the clutch */
     .lock_slip_rad_s = 0.3f, /* rad/s; project default: lock band 2.9 rpm (6 sigma of a 0.5 rpm speed sensor) */
     .breakaway_slip_rad_s = 0.8f, /* rad/s; project default: breakaway band 7.6 rpm (hysteresis above the lock band) */
     .lock_dwell_periods = 10u, /* 1; project default: 10 control periods (10 ms) inside the lock band before locking */

@@ -171,9 +171,10 @@ typedef enum {
 #define WC_CAL_LIMIT_FRITSCH_CARLSON 9.0f
 /* Squeeze film (DESIGN section 9): phi = 0 switches the film state off; else
  * phi in [1e-4, 1]. phi <= 1: grooves and a permeable lining only let the oil
- * out faster than between smooth plates. The lower bound keeps the film's
- * damping 3 pi phi mu_v K / 2 a normal float (mu_v >= its domain minimum);
- * the update is stable for any damping (wc_film_advance_m). */
+ * out faster than between smooth plates. The lower bound keeps phi itself
+ * away from the denormals; the update is stable for any damping, even one
+ * that underflows for a tiny pack or oil (the film then settles at once,
+ * wc_film_advance_m). */
 #define WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MIN 1e-4f
 #define WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MAX 1.0f
 /* Static capacity factor in [0.5, 2]: static over kinetic-at-zero-speed
@@ -184,7 +185,11 @@ typedef enum {
  * lock-up detection, not slip control. */
 #define WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s 10.0f
 #define WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s 20.0f
-/* Holding margin in [0, 1]: up to twice the request's force. */
+/* Holding margin in [0.05, 1]: up to twice the request's force; at least 5 %,
+ * because half of it is the lock-up's torque hysteresis (wc_lockup.h): with
+ * none, a locked clutch held at exactly its request would break away and
+ * re-lock as the capacity drifts (a cooling pack). */
+#define WC_CAL_LIMIT_HOLDING_MARGIN_MIN 0.05f
 #define WC_CAL_LIMIT_HOLDING_MARGIN_MAX 1.0f
 /* Lock dwell 1..255 periods: the firmware counts it in 8 bits. */
 #define WC_CAL_LIMIT_LOCK_DWELL_MAX_periods 255u

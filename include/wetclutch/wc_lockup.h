@@ -2,8 +2,9 @@
  * The paper's friction model is kinetic only (section 3.5: it "cannot express
  * the friction force at zero velocity"); this two-state logic is where it
  * stops. Locked when the slip stays inside the lock band for the dwell and the
- * torque the clutch must carry is below its static capacity; breakaway when
- * the slip leaves the wider breakaway band or the torque reaches the capacity. */
+ * torque the clutch must carry, times 1 + holding_margin / 2, is below its
+ * static capacity; breakaway when the slip leaves the wider breakaway band or
+ * the torque reaches the capacity (hysteresis on both). */
 #ifndef WC_LOCKUP_H
 #define WC_LOCKUP_H
 
@@ -30,7 +31,8 @@ bool wc_lockup_update(wc_lockup_t *lockup, const wc_calibration_t *cal, float sl
                       float capacity_Nm);
 
 /* What a locked clutch transmits: the required torque in the lock direction,
- * at most the capacity, never of the other sign (0 instead). */
+ * at most the capacity, never of the other sign (0 instead); finite for any
+ * input (a NaN or negative capacity holds 0). */
 float wc_lockup_torque_Nm(const wc_lockup_t *lockup, float required_Nm, float capacity_Nm);
 
 #endif /* WC_LOCKUP_H */

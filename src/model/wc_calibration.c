@@ -90,7 +90,7 @@ static const wc_field_limit_t field_limits[] = {
              WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MAX),
     WC_FIELD(lock_slip_rad_s, WC_CAL_LOCK_SLIP, 1u, 0.0f, WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s),
     WC_FIELD(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP, 1u, 0.0f, WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s),
-    WC_FIELD(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, 0.0f, WC_CAL_LIMIT_HOLDING_MARGIN_MAX),
+    WC_FIELD(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, WC_CAL_LIMIT_HOLDING_MARGIN_MIN, WC_CAL_LIMIT_HOLDING_MARGIN_MAX),
 };
 
 /* Every float field has its range: the float fields fill the struct up to

@@ -179,12 +179,16 @@ wc_status_t wc_inverse_holding(const wc_model_t *model, float static_Nm_per_N, f
      * capacity's error. c_s > 0 on the domain (mu2 >= 1e-3, a positive
      * temperature factor and static factor: wc_calibration_check). */
     wc_status_t status = WC_STATUS_OK;
-    float force_N = torque_request_Nm * (1.0f + model->cal->holding_margin) / static_Nm_per_N;
-    if (!(force_N <= model->force_max_N)) {  /* the request's range makes it finite; NaN cannot occur */
-        force_N = model->force_max_N;
-        status |= WC_STATUS_SATURATED;
-    }
+    const wc_calibration_t *cal = model->cal;
+    const float force_N = torque_request_Nm * (1.0f + cal->holding_margin) / static_Nm_per_N;
     out->iterations = 0u;
+    if (!(force_N <= model->force_max_N)) {  /* also NaN (an underflowing capacity): hold with all there is */
+        /* the maximum current itself, as wc_inverse_at_point's saturated branch */
+        out->force_N = model->force_max_N;
+        out->current_mA = cal->vfs_current_max_mA;
+        out->pressure_Pa = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA;
+        return WC_STATUS_SATURATED;
+    }
     finish(model, force_N, &status, out);
     return status;
 }

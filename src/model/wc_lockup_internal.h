@@ -16,8 +16,13 @@ static inline bool wc_lockup_advance(wc_lockup_t *lockup, const wc_calibration_t
                                      float required_Nm, float capacity_Nm)
 {
     const float slip_abs = fabsf(slip_rad_s);
-    /* Strictly below the capacity (NaN fails): a clutch with no force holds nothing. */
-    const bool holds = fabsf(required_Nm) < capacity_Nm;
+    const float required_abs = fabsf(required_Nm);
+    /* Torque hysteresis: a locked clutch holds while the torque stays below its
+     * capacity; it locks only with half the holding margin to spare, so a
+     * capacity that settles at (1 + margin) times the request (the holding
+     * inverse) never decides on rounding. Strict (NaN fails): no force, no hold. */
+    const bool holds = required_abs < capacity_Nm;
+    const bool locks = required_abs * (1.0f + 0.5f * cal->holding_margin) < capacity_Nm;
     if (lockup->locked) {
         /* Breakaway; the wider band is the hysteresis against a noisy slip. */
         if (!(slip_abs <= cal->breakaway_slip_rad_s) || !holds) {
@@ -28,7 +33,7 @@ static inline bool wc_lockup_advance(wc_lockup_t *lockup, const wc_calibration_t
         }
         return lockup->locked;
     }
-    if ((slip_abs < cal->lock_slip_rad_s) && holds) {
+    if ((slip_abs < cal->lock_slip_rad_s) && locks) {
         if (lockup->dwell_periods < UINT8_MAX) { ++lockup->dwell_periods; }
         /* the dwell debounces the lock: one noisy sample inside the band is not a lock */
         lockup->locked = lockup->dwell_periods >= cal->lock_dwell_periods;
@@ -43,7 +48,8 @@ static inline float wc_lockup_held_Nm(const wc_lockup_t *lockup, float required_
 {
     const float direction = (lockup->direction < 0) ? -1.0f : 1.0f;
     const float along = direction * required_Nm;  /* the part in the lock direction */
-    const float held = (along > 0.0f) ? ((along < capacity_Nm) ? along : capacity_Nm) : 0.0f;  /* NaN: 0 */
+    const float limit = (capacity_Nm > 0.0f) ? capacity_Nm : 0.0f;                 /* NaN or negative: 0 */
+    const float held = (along > 0.0f) ? ((along < limit) ? along : limit) : 0.0f;  /* NaN: 0 */
     return direction * held;
 }
 

@@ -302,7 +302,7 @@ static const variant_t rejected_variants[] = {
     V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 0.0f),
     V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 25.0f),
     V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 0.3f),          /* == the lock band: no hysteresis */
-    V1(WC_CAL_HOLDING_MARGIN, holding_margin, -0.01f),
+    V1(WC_CAL_HOLDING_MARGIN, holding_margin, 0.0f),                /* no torque hysteresis */
     V1(WC_CAL_HOLDING_MARGIN, holding_margin, 1.5f),
     /* relations of several fields */
     V2(WC_CAL_CONDUCTANCE_SUM, oil_conductance_W_per_K, 1e-40f, housing_conductance_W_per_K, 0.0f),  /* issue 10 */
@@ -1032,7 +1032,8 @@ static void sweep_clutch(sweep_t *s, wc_clutch_t *clutch)
          * torque, within the static capacity. */
         const float slip = clutch->held.slip_rad_s;
         const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
-        const float sign_slip = (fabsf(slip) < cal->lock_slip_rad_s) ? direction * fmaxf(fabsf(slip), FLT_MIN) : slip;
+        const bool keeps_direction = (fabsf(slip) < cal->lock_slip_rad_s) || ((out.status & WC_STATUS_LOCKED) != 0u);
+        const float sign_slip = keeps_direction ? direction * fmaxf(fabsf(slip), FLT_MIN) : slip;
         check_torque_out(s, &out.model, sign_slip, "wc_clutch_step");
         PHYSICAL(s, isfinite(out.static_capacity_Nm) && (out.static_capacity_Nm >= 0.0f),
                  "wc_clutch_step static capacity %g", (double)out.static_capacity_Nm);

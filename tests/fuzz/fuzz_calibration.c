@@ -283,8 +283,9 @@ static void evaluate(const wc_calibration_t *c)
                      * the held torque, within the static capacity */
                     const float slip = clutch.held.slip_rad_s;
                     const float direction = (clutch.lockup.direction < 0) ? -1.0f : 1.0f;
-                    check_torque(&out.model, (fabsf(slip) < c->lock_slip_rad_s) ? direction * fmaxf(fabsf(slip), FLT_MIN)
-                                                                              : slip, "wc_clutch_step");
+                    const bool keeps_direction = (fabsf(slip) < c->lock_slip_rad_s) || ((out.status & WC_STATUS_LOCKED) != 0u);
+                    check_torque(&out.model, keeps_direction ? direction * fmaxf(fabsf(slip), FLT_MIN) : slip,
+                                 "wc_clutch_step");
                     FZ_CHECK(fz_finite(out.static_capacity_Nm) && (out.static_capacity_Nm >= 0.0f) &&
                                  (((out.status & WC_STATUS_LOCKED) == 0u) ||
                                   (fabsf(out.model.torque_Nm) <= out.static_capacity_Nm)),

@@ -120,6 +120,7 @@ LIMITS: dict[str, float] = {
     "LOCK_SLIP_MAX_rad_s": 10.0,                 # lock band (95 rpm): a lock-up, not a slip controller
     "BREAKAWAY_SLIP_MAX_rad_s": 20.0,            # breakaway band, above the lock band (hysteresis)
     "LOCK_DWELL_MAX_periods": 255,               # the firmware counts the dwell in 8 bits
+    "HOLDING_MARGIN_MIN": 0.05,                  # half of it is the lock-up's torque hysteresis
     "HOLDING_MARGIN_MAX": 1.0,                   # holding force up to twice the request's
 }
 _L = LIMITS
@@ -171,7 +172,7 @@ RANGES: dict[str, tuple[float, bool, float | None]] = {
     "lock_slip": (0.0, False, _L["LOCK_SLIP_MAX_rad_s"]),
     "breakaway_slip": (0.0, False, _L["BREAKAWAY_SLIP_MAX_rad_s"]),    # and > lock_slip
     "lock_dwell": (1.0, True, _L["LOCK_DWELL_MAX_periods"]),
-    "holding_margin": (0.0, True, _L["HOLDING_MARGIN_MAX"]),
+    "holding_margin": (_L["HOLDING_MARGIN_MIN"], True, _L["HOLDING_MARGIN_MAX"]),
 }
 
 

@@ -161,7 +161,7 @@ class FilmTable:
 def reynolds_factor_m4(cal: Calibration) -> float:
     """K = Ro^4 - Ri^4 - (Ro^2 - Ri^2)^2 / ln(Ro/Ri): Reynolds' squeeze film between annular plates.
     Narrow annuli cancel: with s = (Ro - Ri)/(Ro + Ri) < 0.01 the series 8 m^4 s^3 (4/3 + 4/45 s^2 + 44/945 s^4)
-    (m = (Ro + Ri)/2, from ln(Ro/Ri) = 2 atanh s), exact to 1e-16 there."""
+    (m = (Ro + Ri)/2, from ln(Ro/Ri) = 2 atanh s), truncated at about 2e-14 relative there."""
     ro, ri = cal.outer_radius, cal.inner_radius
     s = (ro - ri) / (ro + ri)
     if s < 0.01:
@@ -323,13 +323,14 @@ class Lockup:
     def update(self, slip_rad_s: float, required_Nm: float, capacity_Nm: float) -> bool:
         cal = self.cal
         holds = abs(required_Nm) < capacity_Nm
+        locks = abs(required_Nm) * (1.0 + 0.5 * cal.holding_margin) < capacity_Nm   # torque hysteresis
         if self.locked:
             if not (abs(slip_rad_s) <= cal.breakaway_slip) or not holds:
                 self.locked, self.dwell = False, 0
                 if abs(slip_rad_s) >= cal.lock_slip:   # the slip that broke away sets the direction
                     self.direction = -1.0 if slip_rad_s < 0.0 else 1.0
             return self.locked
-        if abs(slip_rad_s) < cal.lock_slip and holds:
+        if abs(slip_rad_s) < cal.lock_slip and locks:
             self.dwell = min(self.dwell + 1, 255)
             self.locked = self.dwell >= cal.lock_dwell
         else:
@@ -341,7 +342,7 @@ class Lockup:
     def torque_Nm(self, required_Nm: float, capacity_Nm: float) -> float:
         """What a locked clutch transmits: the required torque in the lock direction, at most the capacity."""
         along = self.direction * required_Nm
-        return self.direction * (min(along, capacity_Nm) if along > 0.0 else 0.0)
+        return self.direction * (min(along, max(capacity_Nm, 0.0)) if along > 0.0 else 0.0)
 
 
 def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None):
@@ -481,9 +482,10 @@ def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float) -> di
     holding margin, at most the force at the maximum current (STATUS_SATURATED)."""
     per_N = float(static_capacity_Nm(cal, theta_degC, 1.0))
     force = torque_Nm * (1.0 + cal.holding_margin) / per_N
+    if not force <= force_max_N(cal):   # the maximum current itself (wc_inverse_holding)
+        return {"force_N": force_max_N(cal), "pressure_Pa": cal.vfs_gain * cal.vfs_current_max,
+                "current_mA": cal.vfs_current_max, "status": STATUS_SATURATED}
     status = 0
-    if force > force_max_N(cal):
-        force, status = force_max_N(cal), STATUS_SATURATED
     pressure = (force + cal.return_spring_force) / cal.piston_area
     current = pressure / cal.vfs_gain
     if current < cal.vfs_current_min or current > cal.vfs_current_max:

@@ -52,7 +52,7 @@ def hot_clutch_profile(cal: Calibration):
 # capacity at the steady inverse's force is not exactly the request: no marginal lock decision); the C test
 # sets the same two fields on its copy of wc_table1_calibration.
 EDGES_SQUEEZE_FACTOR = 0.1
-EDGES_STATIC_FACTOR = 1.1
+EDGES_STATIC_FACTOR = 1.25
 
 
 def edges_profile(cal: Calibration):
