@@ -43,7 +43,8 @@ def breakaway(tmp_path_factory):
 
 def test_true_parameters_differ_from_table1_by_a_few_percent(true_cal, cal):
     # The engagement edges (DESIGN 9) are what Table 1's steady model leaves out: a squeeze film (off in
-    # Table 1) and static friction above the kinetic at zero slip (1 in Table 1).
+    # Table 1) and static friction above the kinetic at zero slip (table1.toml: a project default, 1.2; the
+    # bench's lining 1.12, which the identification must find, not copy).
     edges = {"film_squeeze_factor", "static_friction_factor"}
     changed = {k for k in cal.values if cal.values[k] != true_cal.values[k]}
     assert {"mu1", "mu2", "mu3", "stribeck_speed", "oil_conductance", "housing_conductance",
@@ -53,7 +54,7 @@ def test_true_parameters_differ_from_table1_by_a_few_percent(true_cal, cal):
         rel = abs(true_cal.values[k] / cal.values[k] - 1.0)
         assert 0.005 <= rel <= 0.06, (k, rel)
     assert cal.film_squeeze_factor == 0.0 < true_cal.film_squeeze_factor <= 1.0
-    assert cal.static_friction_factor == 1.0 < true_cal.static_friction_factor <= 1.3
+    assert 1.0 < true_cal.static_friction_factor <= 1.3 and true_cal.static_friction_factor != cal.static_friction_factor
     for k in changed:
         assert "bench truth" in true_cal.sources[k]
 
