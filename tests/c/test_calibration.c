@@ -472,44 +472,31 @@ static void test_limits_are_inclusive(void **state)
     }
 }
 
+/* A count field (uint32_t at offset): 0, max + 1 and UINT32_MAX rejected with code, 1 and max accepted. */
+static void check_count_field(size_t offset, uint32_t max, wc_cal_error_t code, const char *name)
+{
+    const uint32_t values[] = { 0u, max + 1u, UINT32_MAX, 1u, max };
+    for (size_t k = 0u; k < WC_TEST_COUNT(values); ++k) {
+        cal_copy_t c;
+        copy_table1(&c);
+        memcpy((unsigned char *)&c.cal + offset, &values[k], sizeof values[k]);
+        expect_code(&c.cal, (k < 3u) ? code : WC_CAL_OK, name, (double)values[k]);
+    }
+    assert_string_equal(wc_cal_error_name(code), name);
+}
+
 static void test_friction_pairs(void **state)
 {
     (void)state;
-    const uint32_t bad[] = { 0u, WC_CAL_LIMIT_FRICTION_PAIRS_MAX + 1u, UINT32_MAX };
-    for (size_t k = 0u; k < WC_TEST_COUNT(bad); ++k) {
-        cal_copy_t c;
-        copy_table1(&c);
-        c.cal.friction_pairs = bad[k];
-        expect_code(&c.cal, WC_CAL_FRICTION_PAIRS, "friction_pairs", (double)bad[k]);
-    }
-    const uint32_t good[] = { 1u, WC_CAL_LIMIT_FRICTION_PAIRS_MAX };
-    for (size_t k = 0u; k < WC_TEST_COUNT(good); ++k) {
-        cal_copy_t c;
-        copy_table1(&c);
-        c.cal.friction_pairs = good[k];
-        expect_code(&c.cal, WC_CAL_OK, "friction_pairs", (double)good[k]);
-    }
-    assert_string_equal(wc_cal_error_name(WC_CAL_FRICTION_PAIRS), "friction_pairs");
+    check_count_field(offsetof(wc_calibration_t, friction_pairs), WC_CAL_LIMIT_FRICTION_PAIRS_MAX,
+                      WC_CAL_FRICTION_PAIRS, "friction_pairs");
 }
 
 static void test_lock_dwell(void **state)
 {
     (void)state;
-    const uint32_t bad[] = { 0u, WC_CAL_LIMIT_LOCK_DWELL_MAX_periods + 1u, UINT32_MAX };
-    for (size_t k = 0u; k < WC_TEST_COUNT(bad); ++k) {
-        cal_copy_t c;
-        copy_table1(&c);
-        c.cal.lock_dwell_periods = bad[k];
-        expect_code(&c.cal, WC_CAL_LOCK_DWELL, "lock_dwell_periods", (double)bad[k]);
-    }
-    const uint32_t good[] = { 1u, WC_CAL_LIMIT_LOCK_DWELL_MAX_periods };
-    for (size_t k = 0u; k < WC_TEST_COUNT(good); ++k) {
-        cal_copy_t c;
-        copy_table1(&c);
-        c.cal.lock_dwell_periods = good[k];
-        expect_code(&c.cal, WC_CAL_OK, "lock_dwell_periods", (double)good[k]);
-    }
-    assert_string_equal(wc_cal_error_name(WC_CAL_LOCK_DWELL), "lock_dwell_periods");
+    check_count_field(offsetof(wc_calibration_t, lock_dwell_periods), WC_CAL_LIMIT_LOCK_DWELL_MAX_periods,
+                      WC_CAL_LOCK_DWELL, "lock_dwell_periods");
 }
 
 static void test_inner_radius_not_below_outer(void **state)

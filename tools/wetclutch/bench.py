@@ -806,30 +806,25 @@ def write_log(path: Path, result: Result) -> int:
     return len(msgs)
 
 
-def write_index(path: Path, cal: Calibration, results: list[Result]) -> None:
-    lines = ["id,force_N,pressure_kPa,slip_rpm,loading_s,theta0_degC,file"]
+# The index columns of each kind (an index CSV lists a campaign's runs: `wetclutch identify` finds them by it).
+_PRESSURE_kPa = ("pressure_kPa", lambda e, cal: f"{e.force_N / cal.friction_area * 1e-3:.1f}")
+INDEX_COLUMNS = {
+    "table2": (_PRESSURE_kPa, ("slip_rpm", lambda e, cal: f"{e.slip_rpm:.0f}"),
+               ("loading_s", lambda e, cal: f"{e.loading_s:.0f}"), ("theta0_degC", lambda e, cal: f"{e.theta0_degC:.0f}")),
+    "engagement": (_PRESSURE_kPa, ("slip_rpm", lambda e, cal: f"{e.slip_rpm:g}"),
+                   ("theta0_degC", lambda e, cal: f"{e.theta0_degC:g}")),
+    "breakaway": (_PRESSURE_kPa, ("theta0_degC", lambda e, cal: f"{e.theta0_degC:g}")),
+}
+INDEX_FILE = {"table2": "index.csv", "engagement": "engagement_index.csv", "breakaway": "breakaway_index.csv"}
+
+
+def write_index(path: Path, cal: Calibration, results: list[Result], kind: str = "table2") -> None:
+    """id, force_N, the kind's columns (INDEX_COLUMNS), file."""
+    columns = INDEX_COLUMNS[kind]
+    lines = [",".join(["id", "force_N", *(name for name, _ in columns), "file"])]
     for r in results:
         e = r.experiment
-        lines.append(f"{e.id},{e.force_N:.1f},{e.force_N / cal.friction_area * 1e-3:.1f},{e.slip_rpm:.0f},"
-                     f"{e.loading_s:.0f},{e.theta0_degC:.0f},{e.name}.csv")
-    atomic.write_text(path, "\n".join(lines) + "\n")
-
-
-def write_engagement_index(path: Path, cal: Calibration, results: list[Result]) -> None:
-    """The engagement runs' index: `wetclutch identify film` finds them by it (a campaign named engagement)."""
-    lines = ["id,force_N,pressure_kPa,slip_rpm,theta0_degC,file"]
-    for r in results:
-        e = r.experiment
-        lines.append(f"{e.id},{e.force_N:.1f},{e.force_N / cal.friction_area * 1e-3:.1f},{e.slip_rpm:g},"
-                     f"{e.theta0_degC:g},{e.name}.csv")
-    atomic.write_text(path, "\n".join(lines) + "\n")
-
-
-def write_breakaway_index(path: Path, cal: Calibration, results: list[Result]) -> None:
-    lines = ["id,force_N,pressure_kPa,theta0_degC,file"]
-    for r in results:
-        e = r.experiment
-        lines.append(f"{e.id},{e.force_N:.1f},{e.force_N / cal.friction_area * 1e-3:.1f},{e.theta0_degC:g},{e.name}.csv")
+        lines.append(",".join([str(e.id), f"{e.force_N:.1f}", *(fmt(e, cal) for _, fmt in columns), f"{e.name}.csv"]))
     atomic.write_text(path, "\n".join(lines) + "\n")
 
 
@@ -889,20 +884,13 @@ def run(kind: str, out_dir, true_path=DEFAULT_TRUE, seed=DEFAULT_SEED, slips_rpm
                 path = out / f"{r.experiment.name}.log"
                 write_log(path, r)
                 files.append(path)
-        if kind == "table2":
-            path = out / "index.csv"
-            write_index(path, true_cal, results)
+        if kind in INDEX_FILE:
+            path = out / INDEX_FILE[kind]
+            write_index(path, true_cal, results, kind)
             files.append(path)
+        if kind == "table2":
             path = out / "viscosity.csv"
             write_viscosity(path, true_cal, seed)
-            files.append(path)
-        if kind == "breakaway":
-            path = out / "breakaway_index.csv"
-            write_breakaway_index(path, true_cal, results)
-            files.append(path)
-        if kind == "engagement":
-            path = out / "engagement_index.csv"
-            write_engagement_index(path, true_cal, results)
             files.append(path)
     return {"files": files, "results": results}
 
