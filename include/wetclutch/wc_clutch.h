@@ -40,6 +40,16 @@ typedef struct {
     float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
     wc_clutch_mode_t mode;
     wc_bench_input_t bench;    /* zero-initialized: not on a bench */
+    /* Hydraulic-lag compensation (DESIGN 9): 0 (zero-initialized) commands the
+     * steady current of the wanted pressure and leaves the VFS lag (tau) to act;
+     * t > 0 leads the lag so that the modelled pressure approaches the wanted
+     * one with time constant t instead of tau, the current bounded to the
+     * solenoid's range. Not finite or negative: off, WC_STATUS_INPUT_INVALID not set. */
+    float lag_compensation_time_s;
+    /* true: the model (inverse and torque) takes the oil temperature instead of
+     * the observer's estimate (a thermal-blind model, for comparisons); the
+     * observer keeps running. */
+    bool theta_from_oil;
 } wc_step_input_t;
 
 typedef struct {
@@ -81,9 +91,10 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *  1. each input is checked; an invalid one is replaced by its last valid
  *     value (held) and flagged, so one bad sample changes no state with a
  *     bad number;
- *  2. WC_MODE_TORQUE: inverse at the current temperature estimate -> current
- *     command (a locked clutch: the force that holds the request with the
- *     holding margin); WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
+ *  2. WC_MODE_TORQUE: inverse at the current temperature estimate (or the oil
+ *     temperature, theta_from_oil) -> current command (a locked clutch: the
+ *     force that holds the request with the holding margin), then led ahead
+ *     of the VFS lag when lag_compensation_time_s > 0; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
  *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
  *     WC_STATUS_TORQUE_INVALID);
  *  3. VFS lag -> modelled pressure -> apply force (on a bench: the measured

@@ -15,6 +15,7 @@
 #include "wc_inverse.h"
 #include "wc_lockup.h"
 #include "wc_clutch.h"
+#include "wc_shift.h"
 
 /* rpm <-> rad/s, for callers whose sensors speak rpm. */
 #define WC_RAD_S_PER_RPM 0.10471975511965977f

@@ -48,27 +48,34 @@ extern "C" {
 /* Frame ids. */
 #define WC_CAN_CLUTCH_SENSORS_FRAME_ID (0x110u)
 #define WC_CAN_TORQUE_REQUEST_FRAME_ID (0x111u)
+#define WC_CAN_SHIFT_COMMAND_FRAME_ID (0x112u)
 #define WC_CAN_VFS_COMMAND_FRAME_ID (0x120u)
 #define WC_CAN_CLUTCH_ESTIMATE_FRAME_ID (0x121u)
+#define WC_CAN_SHIFT_REPORT_FRAME_ID (0x122u)
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
 
 /* Frame lengths in bytes. */
 #define WC_CAN_CLUTCH_SENSORS_LENGTH (8u)
 #define WC_CAN_TORQUE_REQUEST_LENGTH (8u)
+#define WC_CAN_SHIFT_COMMAND_LENGTH (8u)
 #define WC_CAN_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_CLUTCH_ESTIMATE_LENGTH (8u)
+#define WC_CAN_SHIFT_REPORT_LENGTH (8u)
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
 
 /* Extended or standard frame types. */
 #define WC_CAN_CLUTCH_SENSORS_IS_EXTENDED (0)
 #define WC_CAN_TORQUE_REQUEST_IS_EXTENDED (0)
+#define WC_CAN_SHIFT_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_CLUTCH_ESTIMATE_IS_EXTENDED (0)
+#define WC_CAN_SHIFT_REPORT_IS_EXTENDED (0)
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
 
 /* Frame cycle times in milliseconds. */
 #define WC_CAN_CLUTCH_SENSORS_CYCLE_TIME_MS (1u)
 #define WC_CAN_TORQUE_REQUEST_CYCLE_TIME_MS (1u)
+#define WC_CAN_SHIFT_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_VFS_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_CLUTCH_ESTIMATE_CYCLE_TIME_MS (1u)
 #define WC_CAN_BENCH_MEASUREMENT_CYCLE_TIME_MS (1u)
@@ -83,8 +90,15 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE (0u)
 #define WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE (1u)
 #define WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE (2u)
+#define WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE (3u)
 
 #define WC_CAN_TORQUE_REQUEST_TORQUE_REQUEST_SNA_CHOICE (65535u)
+
+#define WC_CAN_SHIFT_COMMAND_TARGET_GEAR_SNA_CHOICE (15u)
+
+#define WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_SNA_CHOICE (-32768)
+
+#define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE (4095u)
 
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_SNA_CHOICE (4095u)
 
@@ -97,6 +111,16 @@ extern "C" {
 
 #define WC_CAN_CLUTCH_ESTIMATE_FILM_THICKNESS_SNA_CHOICE (65535u)
 
+#define WC_CAN_SHIFT_REPORT_PEAK_CLUTCH_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_COMPLETED_CHOICE (0u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_INERTIA_TIMEOUT_CHOICE (1u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_LOCKUP_FAILED_CHOICE (2u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_INPUT_LOST_CHOICE (3u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_CANCELLED_CHOICE (4u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_INVALID_COMMAND_CHOICE (5u)
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_NO_SLIP_CHOICE (6u)
+
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_SNA_CHOICE (-524288)
 
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_SNA_CHOICE (-524288)
@@ -106,8 +130,10 @@ extern "C" {
 /* Frame Names. */
 #define WC_CAN_CLUTCH_SENSORS_NAME "ClutchSensors"
 #define WC_CAN_TORQUE_REQUEST_NAME "TorqueRequest"
+#define WC_CAN_SHIFT_COMMAND_NAME "ShiftCommand"
 #define WC_CAN_VFS_COMMAND_NAME "VfsCommand"
 #define WC_CAN_CLUTCH_ESTIMATE_NAME "ClutchEstimate"
+#define WC_CAN_SHIFT_REPORT_NAME "ShiftReport"
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
 
 /* Signal Names. */
@@ -120,6 +146,12 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_TORQUE_REQUEST_MODE_NAME "Mode"
 #define WC_CAN_TORQUE_REQUEST_TORQUE_REQUEST_NAME "TorqueRequest"
+#define WC_CAN_SHIFT_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_SHIFT_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_SHIFT_COMMAND_SHIFT_REQUEST_NAME "ShiftRequest"
+#define WC_CAN_SHIFT_COMMAND_TARGET_GEAR_NAME "TargetGear"
+#define WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_NAME "TurbineTorque"
+#define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_NAME "TargetInertiaTime"
 #define WC_CAN_VFS_COMMAND_CRC_NAME "Crc"
 #define WC_CAN_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
@@ -144,6 +176,14 @@ extern "C" {
 #define WC_CAN_CLUTCH_ESTIMATE_MODEL_TORQUE_NAME "ModelTorque"
 #define WC_CAN_CLUTCH_ESTIMATE_MU_F_NAME "MuF"
 #define WC_CAN_CLUTCH_ESTIMATE_FILM_THICKNESS_NAME "FilmThickness"
+#define WC_CAN_SHIFT_REPORT_INERTIA_PHASE_TIME_NAME "InertiaPhaseTime"
+#define WC_CAN_SHIFT_REPORT_SLIP_RMSE_NAME "SlipRmse"
+#define WC_CAN_SHIFT_REPORT_PEAK_JERK_NAME "PeakJerk"
+#define WC_CAN_SHIFT_REPORT_FRICTION_ENERGY_NAME "FrictionEnergy"
+#define WC_CAN_SHIFT_REPORT_PEAK_CLUTCH_TEMP_NAME "PeakClutchTemp"
+#define WC_CAN_SHIFT_REPORT_FLARE_NAME "Flare"
+#define WC_CAN_SHIFT_REPORT_TIE_UP_NAME "TieUp"
+#define WC_CAN_SHIFT_REPORT_ABORT_REASON_NAME "AbortReason"
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_NAME "LoadCellForce"
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_NAME "MeasuredTorque"
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
@@ -229,9 +269,9 @@ struct wc_can_torque_request_t {
     uint8_t alive_counter;
 
     /**
-     * Clutch mode. 0 Open: no torque, VFS current at the bottom of its range. 1 TorqueControl: the TCU inverts the model to deliver TorqueRequest. 2 Locked: maximum current (clutch locked), TorqueRequest ignored. 3..15 reserved: implausible input.
+     * Clutch mode. 0 Open: no torque, VFS current at the bottom of its range. 1 TorqueControl: the TCU inverts the model to deliver TorqueRequest. 2 Locked: maximum current (clutch locked), TorqueRequest ignored. 3 Shift: the TCU's shift controller (DESIGN 10) owns the clutch following ShiftCommand, TorqueRequest ignored; ShiftCommand is then a control input with the same timeout and safe state. 4..15 reserved: implausible input.
      *
-     * Range: 0..2 (0..2 -)
+     * Range: 0..3 (0..3 -)
      * Scale: 1
      * Offset: 0
      */
@@ -245,6 +285,69 @@ struct wc_can_torque_request_t {
      * Offset: 0
      */
     uint16_t torque_request;
+};
+
+/**
+ * Signals in message ShiftCommand.
+ *
+ * Shift command of the on-coming clutch (DESIGN 10), 1 ms. E2E protected, data id 0x12. Used while TorqueRequest.Mode is 3 (Shift).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_shift_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x12 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame (same rules as ClutchSensors).
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 1: shift requested; a 0->1 edge starts the shift (prepare, torque phase, inertia phase, lock-up hand-over, locked). 0: no shift; withdrawn before the shift completed, the shift aborts (clutch released, ShiftReport AbortReason 4).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t shift_request;
+
+    /**
+     * Target gear of the shift. Only 2 (the 1->2 upshift) is supported; another value aborts the shift (AbortReason 5).
+     *
+     * Range: 1..8 (1..8 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t target_gear;
+
+    /**
+     * The engine controller's estimate of the turbine torque T_t (DESIGN 10), signed. 0.05 Nm/bit signed 16 bit, valid -1000..1000 Nm; raw -32768 = SNA. The shift controller's feed-forward uses it; a negative value (coast) aborts a shift at its start (AbortReason 5).
+     *
+     * Range: -20000..20000 (-1000..1000 Nm)
+     * Scale: 0.05
+     * Offset: 0
+     */
+    int16_t turbine_torque;
+
+    /**
+     * Target duration of the inertia phase, ms, 12 bit, valid 50..2000 ms (the calibration may narrow it; outside: AbortReason 5). Raw 4095 = SNA.
+     *
+     * Range: 50..2000 (50..2000 ms)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint16_t target_inertia_time;
 };
 
 /**
@@ -479,6 +582,87 @@ struct wc_can_clutch_estimate_t {
      * Offset: 0
      */
     uint16_t film_thickness;
+};
+
+/**
+ * Signals in message ShiftReport.
+ *
+ * Shift report, sent once when a shift ends (locked or aborted), in the step's output after VfsCommand and before ClutchEstimate. The quality vector of the shift (DESIGN 10) as the TCU estimates it.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_shift_report_t {
+    /**
+     * Inertia phase duration, from its start to the lock-up (ms).
+     *
+     * Range: 0..4000 (0..4000 ms)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint16_t inertia_phase_time;
+
+    /**
+     * RMS of slip minus reference slip over the inertia phase (rpm).
+     *
+     * Range: 0..1000 (0..500 rpm)
+     * Scale: 0.5
+     * Offset: 0
+     */
+    uint16_t slip_rmse;
+
+    /**
+     * Peak vehicle jerk estimated from the rate of the model's clutch torque (m/s^3).
+     *
+     * Range: 0..1000 (0..100 m/s^3)
+     * Scale: 0.1
+     * Offset: 0
+     */
+    uint16_t peak_jerk;
+
+    /**
+     * Friction energy of the shift, integral of model torque times slip (kJ).
+     *
+     * Range: 0..4000 (0..40 kJ)
+     * Scale: 0.01
+     * Offset: 0
+     */
+    uint16_t friction_energy;
+
+    /**
+     * Highest friction-surface temperature estimate during the shift (degC).
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t peak_clutch_temp;
+
+    /**
+     * 1: the slip rose above its inertia-phase start value by the calibrated flare margin.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t flare;
+
+    /**
+     * 1: the slip did not fall although the request exceeded the calibrated factor times the turbine torque's share (something held the turbine: the off-going clutch).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t tie_up;
+
+    /**
+     * 0 completed; 1 inertia-phase timeout; 2 not locked after the hand-over; 3 input lost (safe state); 4 cancelled; 5 invalid command; 6 no slip at the inertia-phase start.
+     *
+     * Range: 0..6 (0..6 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t abort_reason;
 };
 
 /**
@@ -788,6 +972,175 @@ bool wc_can_torque_request_torque_request_is_in_range(uint16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_torque_request_torque_request_is_in_phys_range(float value);
+
+/**
+ * Pack message ShiftCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_shift_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_shift_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ShiftCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_shift_command_unpack(
+    struct wc_can_shift_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ShiftCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_shift_command_init(struct wc_can_shift_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_shift_request_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_shift_request_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_target_gear_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_target_gear_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_turbine_torque_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_turbine_torque_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_target_inertia_time_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value);
 
 /**
  * Pack message VfsCommand.
@@ -1390,6 +1743,219 @@ bool wc_can_clutch_estimate_film_thickness_is_in_range(uint16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_clutch_estimate_film_thickness_is_in_phys_range(float value);
+
+/**
+ * Pack message ShiftReport.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_shift_report_pack(
+    uint8_t *dst_p,
+    const struct wc_can_shift_report_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ShiftReport.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_shift_report_unpack(
+    struct wc_can_shift_report_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ShiftReport.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_shift_report_init(struct wc_can_shift_report_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_inertia_phase_time_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_inertia_phase_time_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_slip_rmse_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_slip_rmse_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_peak_jerk_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_peak_jerk_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_friction_energy_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_friction_energy_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_peak_clutch_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_peak_clutch_temp_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_flare_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_flare_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_tie_up_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_tie_up_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_abort_reason_is_in_phys_range(float value);
 
 /**
  * Pack message BenchMeasurement.

@@ -39,12 +39,23 @@ extern const wc_can_signal_t wc_can_sig_clutch_sensors_slip_speed; /* rpm */
 extern const wc_can_signal_t wc_can_sig_clutch_sensors_oil_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_clutch_sensors_housing_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_torque_request_torque_request; /* Nm */
+extern const wc_can_signal_t wc_can_sig_shift_command_shift_request; /* 1 */
+extern const wc_can_signal_t wc_can_sig_shift_command_target_gear; /* 1 */
+extern const wc_can_signal_t wc_can_sig_shift_command_turbine_torque; /* Nm */
+extern const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time; /* ms */
 extern const wc_can_signal_t wc_can_sig_vfs_command_vfs_current; /* mA */
 extern const wc_can_signal_t wc_can_sig_vfs_command_pressure_command; /* kPa */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_estimated_clutch_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_model_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_mu_f; /* 1 */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_film_thickness; /* um */
+extern const wc_can_signal_t wc_can_sig_shift_report_inertia_phase_time; /* ms */
+extern const wc_can_signal_t wc_can_sig_shift_report_slip_rmse; /* rpm */
+extern const wc_can_signal_t wc_can_sig_shift_report_peak_jerk; /* m/s^3 */
+extern const wc_can_signal_t wc_can_sig_shift_report_friction_energy; /* kJ */
+extern const wc_can_signal_t wc_can_sig_shift_report_peak_clutch_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_shift_report_flare; /* 1 */
+extern const wc_can_signal_t wc_can_sig_shift_report_tie_up; /* 1 */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force; /* N */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
@@ -64,6 +75,15 @@ typedef struct {
     uint8_t alive_counter;
 } wc_can_torque_request_phys_t;
 
+/** ShiftCommand (0x112) in physical units. */
+typedef struct {
+    float shift_request;
+    float target_gear;
+    float turbine_torque_Nm;
+    float target_inertia_time_ms;
+    uint8_t alive_counter;
+} wc_can_shift_command_phys_t;
+
 /** VfsCommand (0x120) in physical units. */
 typedef struct {
     float vfs_current_mA;
@@ -81,6 +101,18 @@ typedef struct {
     uint8_t lock_state; /**< WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_*_CHOICE */
 } wc_can_clutch_estimate_phys_t;
 
+/** ShiftReport (0x122) in physical units. */
+typedef struct {
+    float inertia_phase_time_ms;
+    float slip_rmse_rpm;
+    float peak_jerk_m_per_s3;
+    float friction_energy_kJ;
+    float peak_clutch_temp_degC;
+    float flare;
+    float tie_up;
+    uint8_t abort_reason; /**< WC_CAN_SHIFT_REPORT_ABORT_REASON_*_CHOICE */
+} wc_can_shift_report_phys_t;
+
 /** BenchMeasurement (0x130) in physical units. */
 typedef struct {
     float load_cell_force_N;
@@ -96,10 +128,14 @@ wc_can_result_t wc_can_encode_clutch_sensors(uint8_t *dst, const wc_can_clutch_s
 wc_can_result_t wc_can_decode_clutch_sensors(wc_can_clutch_sensors_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_torque_request(uint8_t *dst, const wc_can_torque_request_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_torque_request(wc_can_torque_request_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_estimate_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_clutch_estimate(wc_can_clutch_estimate_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_shift_report(uint8_t *dst, const wc_can_shift_report_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t *dst, const uint8_t *src, size_t size);
 

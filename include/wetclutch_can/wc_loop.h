@@ -63,10 +63,12 @@
 #include "wc_can_frame.h"
 #include "wc_can_signals.h"
 #include <wetclutch/wc_clutch.h>
+#include <wetclutch/wc_shift.h>
 #include "wc_e2e.h"
 
 #define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */
-#define WC_LOOP_TX_FRAMES 2u      /* VfsCommand, ClutchEstimate */
+#define WC_LOOP_TX_CYCLIC 2u      /* every step: VfsCommand, ClutchEstimate */
+#define WC_LOOP_TX_FRAMES 3u      /* at most: ... then ShiftReport in the step a shift ends */
 
 typedef struct {
     uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit (default 10) */
@@ -74,9 +76,10 @@ typedef struct {
     wc_e2e_config_t e2e;               /* MaxDeltaCounter 2 (one lost frame), SyncCounter 3 */
     uint32_t recovery_periods;         /* both inputs fresh this long before the safe state ends (20) */
     bool bench_input_enabled;          /* use BenchMeasurement (bench only; default off) */
+    const wc_shift_calibration_t *shift;  /* shift control (DESIGN 10; checked at init); NULL: off */
 } wc_loop_config_t;
 
-#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false }
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL }
 
 typedef enum {
     WC_REJECT_CRC = 0,      /* E2E CRC mismatch */
@@ -120,7 +123,11 @@ typedef struct {
     wc_loop_input_t sensors_in;
     wc_loop_input_t request_in;
     wc_loop_input_t bench_in;
+    wc_loop_input_t shift_in;
     wc_can_clutch_sensors_phys_t sensors;   /* last valid */
+    wc_can_shift_command_phys_t shift_command;  /* last valid */
+    wc_shift_t shift;                       /* the shift controller (config.shift) */
+    wc_shift_report_t report;               /* the last shift's quality vector */
     wc_can_torque_request_phys_t request;   /* last valid */
     wc_can_bench_measurement_phys_t bench;  /* last valid */
     uint32_t fresh_periods;                 /* consecutive periods with both control inputs fresh */
@@ -131,7 +138,8 @@ typedef struct {
     wc_step_output_t last;                  /* last step's model output */
 } wc_loop_t;
 
-/* Validate the calibration and start in the safe state (no input seen). */
+/* Validate the calibration (and the shift calibration: a failing one returns
+ * WC_CAL_NULL) and start in the safe state (no input seen). */
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC);
 
@@ -153,8 +161,17 @@ typedef enum {
 void wc_loop_port_event(wc_loop_t *loop, wc_loop_port_event_t event, uint32_t count);
 
 /* One control period: process the queued frames, update freshness, step the
- * model, and write the output frames (VfsCommand, ClutchEstimate) to out.
- * Returns the number of frames written (WC_LOOP_TX_FRAMES). */
+ * model (in Shift mode through the shift controller, wc_shift.h), and write
+ * the output frames to out: VfsCommand, ClutchEstimate, and in the step a
+ * shift ends its ShiftReport. Returns the number of frames written
+ * (WC_LOOP_TX_CYCLIC, or WC_LOOP_TX_FRAMES with a report).
+ *
+ * Shift mode (TorqueRequest.Mode 3, only with config.shift): ShiftCommand is
+ * a third control input (E2E, timeout request_timeout_periods, counted as a
+ * request timeout: StatusRequestTimeout) and the safe state applies to it
+ * like to the others; a shift running when the safe state begins aborts
+ * (released, ShiftReport AbortReason 3). Without config.shift, Mode 3 is
+ * implausible and ShiftCommand an unknown id. */
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* When a port's main loop steps the model. */
@@ -174,7 +191,7 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
 /* Receive filter ids for the port: the control frames, then BenchMeasurement,
  * which a port passes only when bench input is enabled (count - 1 otherwise). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
-                         WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
-#define WC_LOOP_RX_ID_COUNT 3u
+                         WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
+#define WC_LOOP_RX_ID_COUNT 4u
 
 #endif /* WC_LOOP_H */

@@ -9,7 +9,9 @@
 /* Sizes the loop relies on. */
 WC_STATIC_ASSERT((WC_LOOP_RX_CAPACITY & (WC_LOOP_RX_CAPACITY - 1u)) == 0u, rx_ring_is_a_power_of_two);
 WC_STATIC_ASSERT(WC_LOOP_RX_CAPACITY >= 2u * WC_LOOP_RX_ID_COUNT, rx_ring_holds_two_periods_of_input);
-WC_STATIC_ASSERT(WC_LOOP_TX_FRAMES == 2u, tx_is_vfs_command_and_clutch_estimate);
+WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == 3u), tx_is_command_estimate_and_report);
+WC_STATIC_ASSERT(WC_CAN_SHIFT_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, shift_command_is_an_e2e_frame);
+WC_STATIC_ASSERT(WC_CAN_SHIFT_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), shift_report_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_CLUTCH_SENSORS_LENGTH == WC_E2E_FRAME_BYTES, clutch_sensors_is_an_e2e_frame);
 WC_STATIC_ASSERT(WC_CAN_TORQUE_REQUEST_LENGTH == WC_E2E_FRAME_BYTES, torque_request_is_an_e2e_frame);
 WC_STATIC_ASSERT(WC_CAN_VFS_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, vfs_command_is_an_e2e_frame);
@@ -31,12 +33,17 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     WC_ASSERT((loop != NULL) && (config != NULL));
     if ((loop == NULL) || (config == NULL)) { return WC_CAL_NULL; }
     memset(loop, 0, sizeof *loop);
+    if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
+        return WC_CAL_NULL;  /* wc_shift_calibration_check says which field */
+    }
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
     if (error != WC_CAL_OK) { return error; }
+    wc_shift_init(&loop->shift);
     loop->config = *config;
     input_reset(&loop->sensors_in);
     input_reset(&loop->request_in);
     input_reset(&loop->bench_in);
+    input_reset(&loop->shift_in);
     loop->sensors.oil_temp_degC = theta_start_degC;
     loop->sensors.housing_temp_degC = theta_start_degC;
     loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
@@ -143,8 +150,15 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
         if (accept(loop, &loop->sensors_in, r, true, s.alive_counter)) { loop->sensors = s; }
     } else if (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID) {
         wc_can_torque_request_phys_t q = {0.0f, 0u, 0u};
-        const wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
+        wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
+        if ((q.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE) && (loop->config.shift == NULL) && (r < WC_CAN_ERR_NAN)) {
+            r = WC_CAN_ERR_RANGE;  /* no shift controller configured: Mode 3 is not a mode here */
+        }
         if (accept(loop, &loop->request_in, r, true, q.alive_counter)) { loop->request = q; }
+    } else if ((f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID) && (loop->config.shift != NULL)) {
+        wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0u};
+        const wc_can_result_t r = wc_can_decode_shift_command(&c, f->data, f->dlc);
+        if (accept(loop, &loop->shift_in, r, true, c.alive_counter)) { loop->shift_command = c; }
     } else if ((f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) && loop->config.bench_input_enabled) {
         wc_can_bench_measurement_phys_t b = {0.0f, 0.0f, 0.0f};
         const wc_can_result_t r = wc_can_decode_bench_measurement(&b, f->data, f->dlc);
@@ -207,7 +221,26 @@ static uint16_t status_bits(wc_status_t status)
     return bits;
 }
 
-/* The two output frames of a step. Apart from wc_loop_step so that its
+/* The shift report frame (DBC ShiftReport) of a finished shift. */
+static WC_NOINLINE void encode_report(const wc_shift_report_t *q, wc_can_frame_t *out)
+{
+    const wc_can_shift_report_phys_t report = {
+        .inertia_phase_time_ms = q->inertia_time_s * 1.0e3f,
+        .slip_rmse_rpm = q->slip_rmse_rad_s / WC_RAD_S_PER_RPM,
+        .peak_jerk_m_per_s3 = q->peak_jerk_m_s3,
+        .friction_energy_kJ = q->friction_energy_J * 1.0e-3f,
+        .peak_clutch_temp_degC = q->peak_theta_degC,
+        .flare = q->flare ? 1.0f : 0.0f,
+        .tie_up = q->tie_up ? 1.0f : 0.0f,
+        .abort_reason = (uint8_t)q->abort_reason,
+    };
+    out->id = WC_CAN_SHIFT_REPORT_FRAME_ID;
+    out->dlc = WC_CAN_SHIFT_REPORT_LENGTH;
+    out->flags = 0u;
+    (void)wc_can_encode_shift_report(out->data, &report, sizeof out->data);  /* saturates to the DBC ranges */
+}
+
+/* The two cyclic output frames of a step. Apart from wc_loop_step so that its
  * locals are not on the stack while the model runs. */
 static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
@@ -273,6 +306,13 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
     if (update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
         bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
+    /* Shift mode: ShiftCommand is a control input too (its staleness counts as the request's). */
+    const bool shift_mode = (loop->config.shift != NULL) && (loop->request.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE);
+    if ((loop->config.shift != NULL) &&
+        update_freshness(&loop->shift_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts) &&
+        shift_mode) {
+        bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
+    }
     /* Debounce: both control inputs fresh for recovery_periods in a row. */
     const bool fresh = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
     loop->fresh_periods = fresh ? ((loop->fresh_periods < UINT32_MAX) ? loop->fresh_periods + 1u : UINT32_MAX) : 0u;
@@ -290,7 +330,22 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         .mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode),
         .bench = { bench_fresh, (load_cell_N > 0.0f) ? load_cell_N : 0.0f, loop->bench.measured_torque_Nm },
     };
-    bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
+    bool report = false;
+    if ((loop->config.shift != NULL) && (shift_mode || (loop->shift.phase != (uint32_t)WC_SHIFT_IDLE))) {
+        /* the shift controller owns the clutch; leaving Shift mode withdraws the command */
+        const wc_can_shift_command_phys_t *c = &loop->shift_command;
+        const wc_shift_command_t command = {
+            .request = shift_mode && (c->shift_request > 0.5f),
+            .target_gear = (uint32_t)c->target_gear,          /* decoded: within [1, 8] */
+            .turbine_torque_Nm = c->turbine_torque_Nm,
+            .target_inertia_time_s = c->target_inertia_time_ms * 1.0e-3f,
+        };
+        report = wc_shift_step(&loop->shift, loop->config.shift, &command, safe, &loop->clutch, &in, &loop->last,
+                               &loop->report);
+        bits |= status_bits(loop->last.status);
+    } else {
+        bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
+    }
     if (bench_fresh) { bits |= WC_CAN_STATUS_BENCH_INPUT; }
     if (safe) {
         bits |= WC_CAN_STATUS_SAFE_STATE_ACTIVE;
@@ -298,9 +353,11 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
     }
 
     encode_outputs(loop, bits, out);
+    uint32_t n = WC_LOOP_TX_CYCLIC;
+    if (report) { encode_report(&loop->report, &out[n++]); }
     loop->counters.steps++;
-    loop->counters.frames_out += WC_LOOP_TX_FRAMES;
-    return WC_LOOP_TX_FRAMES;
+    loop->counters.frames_out += n;
+    return n;
 }
 
 uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,

@@ -49,6 +49,31 @@ static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *
     return status;
 }
 
+/* DESIGN 9, hydraulic lag: the VFS lag is P' = P + (K i - P)(1 - d), d = e^(-dt/tau)
+ * (exact for i held over the period). To move the modelled pressure towards
+ * the wanted P* as a lag of time constant t would, P' = P + (P* - P)(1 - e^(-dt/t)),
+ * the current must be K i = P + (P* - P)(1 - e^(-dt/t)) / (1 - d): a bounded
+ * inverse of the lag, the current clamped to the solenoid's range. t >= tau
+ * asks for no lead (the factor <= 1 is kept: a slower, smoother approach). */
+static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float time_s, wc_inverse_t *inv)
+{
+    const wc_calibration_t *cal = model->cal;
+    if (!(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return WC_STATUS_OK; }  /* also NaN: off */
+    const float wanted_Pa = cal->vfs_gain_Pa_per_mA * inv->current_mA;
+    const float gain = (1.0f - wc_exp(-cal->control_period_s / time_s)) / (1.0f - model->vfs_decay);
+    const float current_mA = (pressure_Pa + (wanted_Pa - pressure_Pa) * gain) / cal->vfs_gain_Pa_per_mA;
+    if (current_mA > cal->vfs_current_max_mA) {
+        inv->current_mA = cal->vfs_current_max_mA;
+        return WC_STATUS_CURRENT_CLAMPED;
+    }
+    if (current_mA < cal->vfs_current_min_mA) {
+        inv->current_mA = cal->vfs_current_min_mA;
+        return WC_STATUS_CURRENT_CLAMPED;
+    }
+    inv->current_mA = current_mA;
+    return WC_STATUS_OK;
+}
+
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
 {
     WC_ASSERT((clutch != NULL) && (in != NULL) && (out != NULL));
@@ -64,13 +89,14 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     wc_status_t status = accept_inputs(&clutch->held, in);
     const wc_held_inputs_t *u = &clutch->held;
 
-    out->theta_degC = clutch->theta_degC;
     /* The inverse and the forward torque see the same (slip, theta): mu_f and
      * mu_v once per step. Every input of the point is valid: the held slip and
-     * request by accept_inputs, the estimate by init and the thermal envelope. */
-    WC_ASSERT(wc_theta_valid(clutch->theta_degC));
+     * request by accept_inputs, the estimate by init and the thermal envelope,
+     * the held oil temperature by accept_inputs. */
+    out->theta_degC = in->theta_from_oil ? u->theta_oil_degC : clutch->theta_degC;
+    WC_ASSERT(wc_theta_valid(out->theta_degC));
     wc_torque_point_t point;
-    wc_torque_point(model, u->slip_rad_s, clutch->theta_degC, &point);
+    wc_torque_point(model, u->slip_rad_s, out->theta_degC, &point);
     const float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
     wc_inverse_t inv;
     if ((in->mode == WC_MODE_TORQUE) && clutch->lockup.locked) {
@@ -84,6 +110,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.force_N = wc_contact_force_at(cal, cal->vfs_gain_Pa_per_mA * inv.current_mA);
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
+    }
+    if ((in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f)) {
+        status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv);
     }
     out->current_mA = inv.current_mA;
     out->force_command_N = inv.force_N;

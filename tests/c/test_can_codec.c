@@ -566,14 +566,14 @@ static void test_round_trip_torque_request(void **state)
 
 static void test_torque_request_reserved_mode(void **state)
 {
-    wc_can_torque_request_phys_t in = {10.0f, 3u, 0u};
+    wc_can_torque_request_phys_t in = {10.0f, 4u, 0u};  /* 3 is Shift (DESIGN 10); 4..15 reserved */
     wc_can_torque_request_phys_t out;
     uint8_t frame[FRAME_BYTES];
 
     (void)state;
     assert_int_equal(wc_can_encode_torque_request(frame, &in, sizeof frame), WC_CAN_ERR_RANGE);
     assert_int_equal(wc_can_decode_torque_request(&out, frame, sizeof frame), WC_CAN_ERR_RANGE);
-    assert_int_equal(out.mode, 3u);
+    assert_int_equal(out.mode, 4u);
     /* SNA torque request */
     in.mode = (uint8_t)WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE;
     in.torque_request_Nm = NAN;

@@ -99,7 +99,7 @@ static void test_loop_contracts(void **state)
     assert_int_equal(wc_loop_init(&loop, &wc_table1_calibration, &config, 40.0f), WC_CAL_OK);
     expect_assert_failure(wc_loop_receive(&loop, NULL));
     expect_assert_failure(wc_loop_step(&loop, NULL));
-    assert_int_equal(wc_loop_step(&loop, out), WC_LOOP_TX_FRAMES);
+    assert_int_equal(wc_loop_step(&loop, out), WC_LOOP_TX_CYCLIC);
 }
 
 int main(void)

@@ -144,7 +144,7 @@ static uint32_t drive(wc_loop_t *loop)
             if (loop->counters.rejected[WC_REJECT_OVERFLOW] != overflows) { tx_log.refused++; }
         }
         if (n == 0u) { continue; }
-        assert_int_equal(n, WC_LOOP_TX_FRAMES);
+        assert_int_equal(n, WC_LOOP_TX_CYCLIC);
         for (uint32_t i = 0u; i < n; ++i) {
             assert_int_equal(mock_port_send(&out[i]), 0);
         }
@@ -285,7 +285,7 @@ static void fixture_init_with(fixture_t *fx, const wc_loop_config_t *config)
  * tests of steady behaviour see control from the first pair of frames. The
  * debounce, SyncCounter and the fault matrix use WC_LOOP_CONFIG_DEFAULT
  * itself (tests/c/test_loop_faults.c). */
-static const wc_loop_config_t config_no_debounce = { 10u, 10u, { 2u, 3u }, 1u, false };
+static const wc_loop_config_t config_no_debounce = { 10u, 10u, { 2u, 3u }, 1u, false, NULL };
 
 static void fixture_init(fixture_t *fx)
 {
@@ -366,7 +366,7 @@ static expected_t ref_step(ref_t *ref, bool safe)
 /* The last step's frames, decoded (the VfsCommand CRC must verify). */
 static void last_outputs(wc_can_vfs_command_phys_t *cmd, wc_can_clutch_estimate_phys_t *est)
 {
-    assert_true(tx_log.count >= WC_LOOP_TX_FRAMES);
+    assert_true(tx_log.count >= WC_LOOP_TX_CYCLIC);
     const wc_can_frame_t *vfs = &tx_log.frames[tx_log.count - 2u];
     const wc_can_frame_t *estimate = &tx_log.frames[tx_log.count - 1u];
     assert_int_equal(wc_can_decode_vfs_command(cmd, vfs->data, vfs->dlc), WC_CAN_OK);
@@ -704,7 +704,7 @@ static void sensor_timeout_case(fixture_t *fx, const wc_loop_config_t *config)
 
 /* Timeouts of the default configuration and two others (sensor, request). */
 static const wc_loop_config_t timeout_configs[] = {
-    { 10u, 10u, { 2u, 3u }, 1u, false }, { 3u, 25u, { 2u, 1u }, 1u, false }, { 1u, 1u, { 2u, 2u }, 1u, false }
+    { 10u, 10u, { 2u, 3u }, 1u, false, NULL }, { 3u, 25u, { 2u, 1u }, 1u, false, NULL }, { 1u, 1u, { 2u, 2u }, 1u, false, NULL }
 };
 
 static void test_sensor_timeout_and_recovery(void **state)
@@ -1075,7 +1075,7 @@ static void test_implausible_signals(void **state)
         { "HousingTemp above 200 degC", SIG_HOUSING, housing->raw_max + 1 },
         { "TorqueRequest SNA", SIG_TORQUE, (int32_t)WC_CAN_TORQUE_REQUEST_TORQUE_REQUEST_SNA_CHOICE },
         { "TorqueRequest above 2000 Nm", SIG_TORQUE, torque->raw_max + 1 },
-        { "Mode 3 (reserved)", SIG_MODE, 3 },
+        { "Mode 4 (reserved)", SIG_MODE, 4 },
         { "Mode 15 (reserved)", SIG_MODE, 15 },
     };
     for (size_t i = 0u; i < WC_TEST_COUNT(cases); ++i) {
@@ -1307,7 +1307,7 @@ static void test_counters_add_up(void **state)
     assert_int_equal(c->steps, engagement.steps);
     assert_int_equal(c->steps, tx_log.steps);
     assert_int_equal(c->frames_out, tx_log.count);
-    assert_int_equal(c->frames_out, WC_LOOP_TX_FRAMES * c->steps);
+    assert_int_equal(c->frames_out, WC_LOOP_TX_CYCLIC * c->steps);
     assert_int_equal(tx_log.refused, 0u);
     assert_int_equal(c->sensor_timeouts + c->request_timeouts + c->safe_steps, 0u);
     /* every reason the script exercises was seen once */

@@ -34,7 +34,7 @@ int main(void)
     const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     wc_can_frame_t tx[WC_LOOP_TX_FRAMES];
     const int loop_ok = (wc_loop_init(&loop, &wc_table1_calibration, &config, 80.0f) == WC_CAL_OK) &&
-                        (wc_loop_step(&loop, tx) == WC_LOOP_TX_FRAMES) && (tx[0].id == WC_CAN_VFS_COMMAND_FRAME_ID);
+                        (wc_loop_step(&loop, tx) == WC_LOOP_TX_CYCLIC) && (tx[0].id == WC_CAN_VFS_COMMAND_FRAME_ID);
     printf("wc_consumer: loop step sent 0x%03x (no input yet: safe state)\n", (unsigned)tx[0].id);
     return (ok && loop_ok) ? 0 : 1;
 }

@@ -29,7 +29,7 @@
  *   frame, ...), 2 a wrong CRC (one more byte), 3 the frame as fuzzed.
  *
  * Oracle after every wc_loop_iterate (abort with a message on violation):
- *  - it returns WC_LOOP_TX_FRAMES exactly when the clock says so (a tick, or
+ *  - it returns WC_LOOP_TX_CYCLIC exactly when the clock says so (a tick, or
  *    with the frame clock a ClutchSensors frame without flags), else 0;
  *  - the step's frames: VfsCommand (0x120, DLC 8) decodes with a good CRC,
  *    its alive counter counts +1, reserved status bits are 0; VfsCurrent
@@ -247,9 +247,9 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
     const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
                                    (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
-    FZ_CHECK(n == (expected ? WC_LOOP_TX_FRAMES : 0u), "wc_loop_iterate returned %u, expected %u", (unsigned)n,
-             expected ? (unsigned)WC_LOOP_TX_FRAMES : 0u);
-    if (n == WC_LOOP_TX_FRAMES) {
+    FZ_CHECK(n == (expected ? WC_LOOP_TX_CYCLIC : 0u), "wc_loop_iterate returned %u, expected %u", (unsigned)n,
+             expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u);
+    if (n == WC_LOOP_TX_CYCLIC) {
         check_step(h, out);
     } else {
         check_counters(h);

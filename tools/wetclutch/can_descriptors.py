@@ -26,6 +26,7 @@ Usage: python -m wetclutch.can_descriptors DBC HEADER_OUT SOURCE_OUT
 """
 from __future__ import annotations
 
+import re
 import math
 import os
 import sys
@@ -119,7 +120,9 @@ def _signal(message, s) -> Signal:
         return Signal(s.name, snake, "enum", raw_type, n, field=snake,
                       raw_min=int(s.minimum), raw_max=int(s.maximum))
     unit = s.unit or ""
-    field = f"{snake}_{unit}" if unit else snake
+    # the unit as a C identifier suffix: "m/s^3" -> m_per_s3 (one unit per field name, STYLE)
+    suffix = re.sub(r"[^0-9A-Za-z_]", "", unit.replace("/", "_per_"))
+    field = f"{snake}_{suffix}" if suffix else snake
     sig = Signal(s.name, snake, "scaled", raw_type, n, field=field, unit=unit, scale=float(s.scale),
                  offset=float(s.offset), raw_min=_to_raw(message.name, s, s.minimum),
                  raw_max=_to_raw(message.name, s, s.maximum), raw_sna=sna[0] if sna else None)

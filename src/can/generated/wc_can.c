@@ -296,12 +296,12 @@ bool wc_can_torque_request_alive_counter_is_in_phys_range(float value)
 
 bool wc_can_torque_request_mode_is_in_range(uint8_t value)
 {
-    return (value <= 2u);
+    return (value <= 3u);
 }
 
 bool wc_can_torque_request_mode_is_in_phys_range(float value)
 {
-    return ((value >= 0.0f) && (value <= 2.0f));
+    return ((value >= 0.0f) && (value <= 3.0f));
 }
 
 bool wc_can_torque_request_torque_request_is_in_range(uint16_t value)
@@ -312,6 +312,127 @@ bool wc_can_torque_request_torque_request_is_in_range(uint16_t value)
 bool wc_can_torque_request_torque_request_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+int wc_can_shift_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_shift_command_t *src_p,
+    size_t size)
+{
+    uint16_t turbine_torque;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->shift_request, 4u, 0x10u);
+    dst_p[2] |= pack_left_shift_u8(src_p->target_gear, 0u, 0x0fu);
+    turbine_torque = (uint16_t)src_p->turbine_torque;
+    dst_p[3] |= pack_left_shift_u16(turbine_torque, 0u, 0xffu);
+    dst_p[4] |= pack_right_shift_u16(turbine_torque, 8u, 0xffu);
+    dst_p[5] |= pack_left_shift_u16(src_p->target_inertia_time, 0u, 0xffu);
+    dst_p[6] |= pack_right_shift_u16(src_p->target_inertia_time, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_shift_command_unpack(
+    struct wc_can_shift_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    uint16_t turbine_torque;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->shift_request = unpack_right_shift_u8(src_p[1], 4u, 0x10u);
+    dst_p->target_gear = unpack_right_shift_u8(src_p[2], 0u, 0x0fu);
+    turbine_torque = unpack_right_shift_u16(src_p[3], 0u, 0xffu);
+    turbine_torque |= unpack_left_shift_u16(src_p[4], 8u, 0xffu);
+    dst_p->turbine_torque = (int16_t)turbine_torque;
+    dst_p->target_inertia_time = unpack_right_shift_u16(src_p[5], 0u, 0xffu);
+    dst_p->target_inertia_time |= unpack_left_shift_u16(src_p[6], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_shift_command_init(struct wc_can_shift_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_shift_command_t));
+
+    return 0;
+}
+
+bool wc_can_shift_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_shift_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_shift_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_shift_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_shift_command_shift_request_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_shift_command_shift_request_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_shift_command_target_gear_is_in_range(uint8_t value)
+{
+    return ((value >= 1u) && (value <= 8u));
+}
+
+bool wc_can_shift_command_target_gear_is_in_phys_range(float value)
+{
+    return ((value >= 1.0f) && (value <= 8.0f));
+}
+
+bool wc_can_shift_command_turbine_torque_is_in_range(int16_t value)
+{
+    return ((value >= -20000) && (value <= 20000));
+}
+
+bool wc_can_shift_command_turbine_torque_is_in_phys_range(float value)
+{
+    return ((value >= -1000.0f) && (value <= 1000.0f));
+}
+
+bool wc_can_shift_command_target_inertia_time_is_in_range(uint16_t value)
+{
+    return ((value >= 50u) && (value <= 2000u));
+}
+
+bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value)
+{
+    return ((value >= 50.0f) && (value <= 2000.0f));
 }
 
 int wc_can_vfs_command_pack(
@@ -694,6 +815,149 @@ bool wc_can_clutch_estimate_film_thickness_is_in_range(uint16_t value)
 bool wc_can_clutch_estimate_film_thickness_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 65.0f));
+}
+
+int wc_can_shift_report_pack(
+    uint8_t *dst_p,
+    const struct wc_can_shift_report_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u16(src_p->inertia_phase_time, 0u, 0xffu);
+    dst_p[1] |= pack_right_shift_u16(src_p->inertia_phase_time, 8u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u16(src_p->slip_rmse, 4u, 0xf0u);
+    dst_p[2] |= pack_right_shift_u16(src_p->slip_rmse, 4u, 0x3fu);
+    dst_p[2] |= pack_left_shift_u16(src_p->peak_jerk, 6u, 0xc0u);
+    dst_p[3] |= pack_right_shift_u16(src_p->peak_jerk, 2u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->friction_energy, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->friction_energy, 8u, 0x0fu);
+    dst_p[5] |= pack_left_shift_u16(src_p->peak_clutch_temp, 4u, 0xf0u);
+    dst_p[6] |= pack_right_shift_u16(src_p->peak_clutch_temp, 4u, 0xffu);
+    dst_p[7] |= pack_left_shift_u8(src_p->flare, 0u, 0x01u);
+    dst_p[7] |= pack_left_shift_u8(src_p->tie_up, 1u, 0x02u);
+    dst_p[7] |= pack_left_shift_u8(src_p->abort_reason, 2u, 0x1cu);
+
+    return (8);
+}
+
+int wc_can_shift_report_unpack(
+    struct wc_can_shift_report_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->inertia_phase_time = unpack_right_shift_u16(src_p[0], 0u, 0xffu);
+    dst_p->inertia_phase_time |= unpack_left_shift_u16(src_p[1], 8u, 0x0fu);
+    dst_p->slip_rmse = unpack_right_shift_u16(src_p[1], 4u, 0xf0u);
+    dst_p->slip_rmse |= unpack_left_shift_u16(src_p[2], 4u, 0x3fu);
+    dst_p->peak_jerk = unpack_right_shift_u16(src_p[2], 6u, 0xc0u);
+    dst_p->peak_jerk |= unpack_left_shift_u16(src_p[3], 2u, 0xffu);
+    dst_p->friction_energy = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->friction_energy |= unpack_left_shift_u16(src_p[5], 8u, 0x0fu);
+    dst_p->peak_clutch_temp = unpack_right_shift_u16(src_p[5], 4u, 0xf0u);
+    dst_p->peak_clutch_temp |= unpack_left_shift_u16(src_p[6], 4u, 0xffu);
+    dst_p->flare = unpack_right_shift_u8(src_p[7], 0u, 0x01u);
+    dst_p->tie_up = unpack_right_shift_u8(src_p[7], 1u, 0x02u);
+    dst_p->abort_reason = unpack_right_shift_u8(src_p[7], 2u, 0x1cu);
+
+    return (0);
+}
+
+int wc_can_shift_report_init(struct wc_can_shift_report_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_shift_report_t));
+
+    return 0;
+}
+
+bool wc_can_shift_report_inertia_phase_time_is_in_range(uint16_t value)
+{
+    return (value <= 4000u);
+}
+
+bool wc_can_shift_report_inertia_phase_time_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_shift_report_slip_rmse_is_in_range(uint16_t value)
+{
+    return (value <= 1000u);
+}
+
+bool wc_can_shift_report_slip_rmse_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 500.0f));
+}
+
+bool wc_can_shift_report_peak_jerk_is_in_range(uint16_t value)
+{
+    return (value <= 1000u);
+}
+
+bool wc_can_shift_report_peak_jerk_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 100.0f));
+}
+
+bool wc_can_shift_report_friction_energy_is_in_range(uint16_t value)
+{
+    return (value <= 4000u);
+}
+
+bool wc_can_shift_report_friction_energy_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 40.0f));
+}
+
+bool wc_can_shift_report_peak_clutch_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_shift_report_peak_clutch_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+bool wc_can_shift_report_flare_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_shift_report_flare_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_shift_report_tie_up_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_shift_report_tie_up_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value)
+{
+    return (value <= 6u);
+}
+
+bool wc_can_shift_report_abort_reason_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 6.0f));
 }
 
 int wc_can_bench_measurement_pack(

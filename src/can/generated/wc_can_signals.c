@@ -22,6 +22,22 @@ const wc_can_signal_t wc_can_sig_torque_request_torque_request = {
     .scale = 0.05f, .offset = 0.0f, .raw_min = 0, .raw_max = 40000,
     .raw_nan = (int32_t)WC_CAN_TORQUE_REQUEST_TORQUE_REQUEST_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_TORQUE_REQUEST_TORQUE_REQUEST_SNA_CHOICE, .has_sna = true,
 };
+const wc_can_signal_t wc_can_sig_shift_command_shift_request = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_command_target_gear = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 1, .raw_max = 8,
+    .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_GEAR_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_GEAR_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_shift_command_turbine_torque = {
+    .scale = 0.05f, .offset = 0.0f, .raw_min = -20000, .raw_max = 20000,
+    .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 50, .raw_max = 2000,
+    .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .has_sna = true,
+};
 const wc_can_signal_t wc_can_sig_vfs_command_vfs_current = {
     .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
@@ -45,6 +61,34 @@ const wc_can_signal_t wc_can_sig_clutch_estimate_mu_f = {
 const wc_can_signal_t wc_can_sig_clutch_estimate_film_thickness = {
     .scale = 0.001f, .offset = 0.0f, .raw_min = 0, .raw_max = 65000,
     .raw_nan = (int32_t)WC_CAN_CLUTCH_ESTIMATE_FILM_THICKNESS_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_CLUTCH_ESTIMATE_FILM_THICKNESS_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_shift_report_inertia_phase_time = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 4000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_report_slip_rmse = {
+    .scale = 0.5f, .offset = 0.0f, .raw_min = 0, .raw_max = 1000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_report_peak_jerk = {
+    .scale = 0.1f, .offset = 0.0f, .raw_min = 0, .raw_max = 1000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_report_friction_energy = {
+    .scale = 0.01f, .offset = 0.0f, .raw_min = 0, .raw_max = 4000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_report_peak_clutch_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_SHIFT_REPORT_PEAK_CLUTCH_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_REPORT_PEAK_CLUTCH_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_shift_report_flare = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_shift_report_tie_up = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
 const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force = {
     .scale = 0.1f, .offset = 0.0f, .raw_min = -200000, .raw_max = 200000,
@@ -134,7 +178,7 @@ wc_can_result_t wc_can_encode_torque_request(uint8_t *dst, const wc_can_torque_r
     }
     msg.torque_request = (uint16_t)to_raw(&wc_can_sig_torque_request_torque_request, src->torque_request_Nm, &result);
     msg.mode = (uint8_t)(src->mode & 0x0Fu);
-    if (src->mode > 2u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    if (src->mode > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
     msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
     msg.crc = 0u;
     if (wc_can_torque_request_pack(dst, &msg, size) < 0) {
@@ -163,6 +207,51 @@ wc_can_result_t wc_can_decode_torque_request(wc_can_torque_request_phys_t *dst, 
     if (!wc_can_torque_request_mode_is_in_range(msg.mode)) {
         result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
     }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ShiftCommand (E2E) */
+
+wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_command_phys_t *src, size_t size)
+{
+    struct wc_can_shift_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_SHIFT_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.shift_request = (uint8_t)to_raw(&wc_can_sig_shift_command_shift_request, src->shift_request, &result);
+    msg.target_gear = (uint8_t)to_raw(&wc_can_sig_shift_command_target_gear, src->target_gear, &result);
+    msg.turbine_torque = (int16_t)to_raw(&wc_can_sig_shift_command_turbine_torque, src->turbine_torque_Nm, &result);
+    msg.target_inertia_time = (uint16_t)to_raw(&wc_can_sig_shift_command_target_inertia_time, src->target_inertia_time_ms, &result);
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_shift_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_SHIFT_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_shift_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_SHIFT_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_SHIFT_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_shift_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->shift_request = to_phys(&wc_can_sig_shift_command_shift_request, msg.shift_request, &result);
+    dst->target_gear = to_phys(&wc_can_sig_shift_command_target_gear, msg.target_gear, &result);
+    dst->turbine_torque_Nm = to_phys(&wc_can_sig_shift_command_turbine_torque, msg.turbine_torque, &result);
+    dst->target_inertia_time_ms = to_phys(&wc_can_sig_shift_command_target_inertia_time, msg.target_inertia_time, &result);
     dst->alive_counter = msg.alive_counter;
     return result;
 }
@@ -254,6 +343,56 @@ wc_can_result_t wc_can_decode_clutch_estimate(wc_can_clutch_estimate_phys_t *dst
     dst->film_thickness_um = to_phys(&wc_can_sig_clutch_estimate_film_thickness, msg.film_thickness, &result);
     dst->lock_state = msg.lock_state;
     if (!wc_can_clutch_estimate_lock_state_is_in_range(msg.lock_state)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    return result;
+}
+
+/* ShiftReport */
+
+wc_can_result_t wc_can_encode_shift_report(uint8_t *dst, const wc_can_shift_report_phys_t *src, size_t size)
+{
+    struct wc_can_shift_report_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_SHIFT_REPORT_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.inertia_phase_time = (uint16_t)to_raw(&wc_can_sig_shift_report_inertia_phase_time, src->inertia_phase_time_ms, &result);
+    msg.slip_rmse = (uint16_t)to_raw(&wc_can_sig_shift_report_slip_rmse, src->slip_rmse_rpm, &result);
+    msg.peak_jerk = (uint16_t)to_raw(&wc_can_sig_shift_report_peak_jerk, src->peak_jerk_m_per_s3, &result);
+    msg.friction_energy = (uint16_t)to_raw(&wc_can_sig_shift_report_friction_energy, src->friction_energy_kJ, &result);
+    msg.peak_clutch_temp = (uint16_t)to_raw(&wc_can_sig_shift_report_peak_clutch_temp, src->peak_clutch_temp_degC, &result);
+    msg.flare = (uint8_t)to_raw(&wc_can_sig_shift_report_flare, src->flare, &result);
+    msg.tie_up = (uint8_t)to_raw(&wc_can_sig_shift_report_tie_up, src->tie_up, &result);
+    msg.abort_reason = (uint8_t)(src->abort_reason & 0x07u);
+    if (src->abort_reason > 6u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    if (wc_can_shift_report_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_shift_report_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_SHIFT_REPORT_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_shift_report_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->inertia_phase_time_ms = to_phys(&wc_can_sig_shift_report_inertia_phase_time, msg.inertia_phase_time, &result);
+    dst->slip_rmse_rpm = to_phys(&wc_can_sig_shift_report_slip_rmse, msg.slip_rmse, &result);
+    dst->peak_jerk_m_per_s3 = to_phys(&wc_can_sig_shift_report_peak_jerk, msg.peak_jerk, &result);
+    dst->friction_energy_kJ = to_phys(&wc_can_sig_shift_report_friction_energy, msg.friction_energy, &result);
+    dst->peak_clutch_temp_degC = to_phys(&wc_can_sig_shift_report_peak_clutch_temp, msg.peak_clutch_temp, &result);
+    dst->flare = to_phys(&wc_can_sig_shift_report_flare, msg.flare, &result);
+    dst->tie_up = to_phys(&wc_can_sig_shift_report_tie_up, msg.tie_up, &result);
+    dst->abort_reason = msg.abort_reason;
+    if (!wc_can_shift_report_abort_reason_is_in_range(msg.abort_reason)) {
         result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
     }
     return result;

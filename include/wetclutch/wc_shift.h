@@ -1,0 +1,187 @@
+/* On-coming clutch control of a 1->2 upshift (DESIGN section 10): a phase
+ * state machine, the inertia phase's reference slip, the driveline model's
+ * feed-forward torque and a PI on the slip (2-DOF), passed through the clutch
+ * model's inverse and the VFS lag compensation (wc_clutch_step), plus the
+ * shift's quality vector. All state in wc_shift_t (caller-owned), the shift
+ * calibration read-only; the clutch is the caller's wc_clutch_t, which the
+ * shift controller steps while a shift runs.
+ *
+ * Phases (wc_shift_phase_t):
+ *   IDLE      no shift: the clutch is released (minimum current).
+ *   PREPARE   prepare_time_s after the command: torque request 0, i.e. the
+ *             piston filled to its spring preload (kiss point).
+ *   TORQUE    torque phase, torque_phase_time_s: the request ramps linearly
+ *             from 0 to the turbine torque's share T_t / a while the
+ *             off-going clutch releases (the off-going is not ours).
+ *   INERTIA   the reference slip goes from the slip at phase start to 0 in
+ *             the commanded target time with zero slope at both ends
+ *             (smoothstep); request = feed-forward + PI(slip - reference).
+ *             Ends when the clutch model locks (wc_lockup, DESIGN 9).
+ *   LOCKUP    hand-over: the request ramps to holding_torque_factor * T_t / a
+ *             in lockup_ramp_time_s (the lock-up adds its holding margin).
+ *   LOCKED    shift complete; the holding request stays until the command ends.
+ *   ABORTED   released to the safe state (minimum current) until the command
+ *             ends; the report says why.
+ * The report (wc_shift_report_t) is produced once, on entering LOCKED or
+ * ABORTED. */
+#ifndef WC_SHIFT_H
+#define WC_SHIFT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "wc_clutch.h"
+
+typedef enum {
+    WC_SHIFT_IDLE = 0,
+    WC_SHIFT_PREPARE,
+    WC_SHIFT_TORQUE,
+    WC_SHIFT_INERTIA,
+    WC_SHIFT_LOCKUP,
+    WC_SHIFT_LOCKED,
+    WC_SHIFT_ABORTED
+} wc_shift_phase_t;
+
+/* Why a shift ended without completing. The values are those of the DBC
+ * signal ShiftReport.AbortReason. */
+typedef enum {
+    WC_SHIFT_ABORT_NONE = 0,
+    WC_SHIFT_ABORT_INERTIA_TIMEOUT = 1,  /* inertia phase longer than target * inertia_timeout_factor */
+    WC_SHIFT_ABORT_LOCKUP_FAILED = 2,    /* the clutch was not locked at the end of the hand-over */
+    WC_SHIFT_ABORT_INPUT_LOST = 3,       /* the frame loop went to its safe state during the shift */
+    WC_SHIFT_ABORT_CANCELLED = 4,        /* the command was withdrawn before the shift completed */
+    WC_SHIFT_ABORT_INVALID_COMMAND = 5,  /* target gear not 2, target time or turbine torque out of range */
+    WC_SHIFT_ABORT_NO_SLIP = 6           /* slip at inertia start not above min_start_slip_rad_s */
+} wc_shift_abort_t;
+
+/* Which temperature the clutch model uses during a shift. */
+typedef enum {
+    WC_SHIFT_THETA_OBSERVER = 0,  /* the thermal observer's friction-surface estimate (eq. 1) */
+    WC_SHIFT_THETA_OIL = 1        /* the oil temperature: a thermal-blind model (comparison only) */
+} wc_shift_theta_source_t;
+
+typedef struct {
+    /* The TCU's driveline model (DESIGN 10): the turbine side and the clutch's kinematics. */
+    float turbine_inertia_kg_m2;       /* I_t: turbine + engine (converter locked) */
+    float turbine_ratio;               /* a in slip = a w_t - b w_o: clutch slip per turbine speed */
+    float jerk_per_torque_rate;        /* vehicle jerk per on-coming clutch torque rate, (m/s^3) / (Nm/s): b r_f / (m r_w) */
+    /* Phases */
+    float prepare_time_s;
+    float torque_phase_time_s;
+    float inertia_time_min_s;          /* accepted commanded target inertia times */
+    float inertia_time_max_s;
+    float inertia_timeout_factor;      /* abort when the inertia phase exceeds target * this (> 1) */
+    float lockup_ramp_time_s;          /* hand-over to the holding torque */
+    float holding_torque_factor;       /* holding request / (T_t / a), >= 1 */
+    float min_start_slip_rad_s;        /* slip at inertia start must exceed it */
+    /* 2-DOF control */
+    float feedforward_gain;            /* 1: the driveline feed-forward; 0: feedback only (comparison) */
+    float kp_Nm_per_rad_s;             /* PI on the slip error (slip - reference) */
+    float ki_Nm_per_rad;
+    float integral_limit_Nm;           /* |integral term| bound (anti-windup) */
+    float lag_compensation_time_s;     /* wc_step_input_t.lag_compensation_time_s; 0: off */
+    uint32_t theta_source;             /* wc_shift_theta_source_t */
+    /* Quality */
+    float flare_slip_rad_s;            /* slip above the slip at inertia start + this: flare */
+    float tie_up_factor;               /* torque-phase request estimate above factor * T_t / a while the slip holds: tie-up */
+    float jerk_filter_time_s;          /* first-order filter on the torque before its rate is taken */
+} wc_shift_calibration_t;
+
+/* Which field an invalid shift calibration fails on (0 = valid): the fields
+ * in declaration order. */
+typedef enum {
+    WC_SHIFT_CAL_OK = 0,
+    WC_SHIFT_CAL_NULL,
+    WC_SHIFT_CAL_TURBINE_INERTIA,
+    WC_SHIFT_CAL_TURBINE_RATIO,
+    WC_SHIFT_CAL_JERK_PER_TORQUE_RATE,
+    WC_SHIFT_CAL_PREPARE_TIME,
+    WC_SHIFT_CAL_TORQUE_PHASE_TIME,
+    WC_SHIFT_CAL_INERTIA_TIME_MIN,
+    WC_SHIFT_CAL_INERTIA_TIME_MAX,     /* also: below the minimum */
+    WC_SHIFT_CAL_INERTIA_TIMEOUT_FACTOR,
+    WC_SHIFT_CAL_LOCKUP_RAMP_TIME,
+    WC_SHIFT_CAL_HOLDING_TORQUE_FACTOR,
+    WC_SHIFT_CAL_MIN_START_SLIP,
+    WC_SHIFT_CAL_FEEDFORWARD_GAIN,
+    WC_SHIFT_CAL_KP,
+    WC_SHIFT_CAL_KI,
+    WC_SHIFT_CAL_INTEGRAL_LIMIT,
+    WC_SHIFT_CAL_LAG_COMPENSATION_TIME,
+    WC_SHIFT_CAL_THETA_SOURCE,
+    WC_SHIFT_CAL_FLARE_SLIP,
+    WC_SHIFT_CAL_TIE_UP_FACTOR,
+    WC_SHIFT_CAL_JERK_FILTER_TIME,
+    WC_SHIFT_CAL_ERRORS
+} wc_shift_cal_error_t;
+
+/* Limits of wc_shift_calibration_check: every time within [0, 10] s (the
+ * inertia times within [0.05, 5] s, the jerk filter and the lag compensation
+ * time 0 or >= 1e-3 s), the inertia within (0, 100] kg m^2, the ratio within
+ * [0.05, 20], gains within [0, 1e5], factors as commented. */
+#define WC_SHIFT_LIMIT_TIME_MAX_s 10.0f
+#define WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s 0.05f
+#define WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s 5.0f
+#define WC_SHIFT_LIMIT_GAIN_MAX 1e5f
+
+wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal);
+
+/* The shift command (DBC ShiftCommand), as the frame loop received it. */
+typedef struct {
+    bool request;                  /* 1: shift on; a rising edge while IDLE starts it; 0: end/cancel */
+    uint32_t target_gear;          /* only 2 (the 1->2 upshift) is supported */
+    float turbine_torque_Nm;       /* the engine controller's turbine torque estimate T_t */
+    float target_inertia_time_s;   /* in [inertia_time_min_s, inertia_time_max_s] */
+} wc_shift_command_t;
+
+/* The quality vector of one shift (DESIGN 10; DBC ShiftReport). */
+typedef struct {
+    float inertia_time_s;          /* inertia phase start to lock (0 if it never started) */
+    float slip_rmse_rad_s;         /* RMS(slip - reference) over the inertia phase */
+    float peak_jerk_m_s3;          /* |jerk_per_torque_rate * d(filtered request torque)/dt|, max over the shift */
+    float friction_energy_J;       /* integral of |T dw| (model torque) over the shift */
+    float peak_theta_degC;         /* highest friction-surface estimate during the shift */
+    bool flare;
+    bool tie_up;
+    uint32_t abort_reason;         /* wc_shift_abort_t */
+} wc_shift_report_t;
+
+typedef struct {
+    uint32_t phase;                /* wc_shift_phase_t */
+    uint32_t phase_periods;        /* periods spent in the phase */
+    bool last_request;             /* the command's request bit at the previous step (edge detection) */
+    float turbine_torque_Nm;       /* T_t latched, then followed from the command */
+    float target_time_s;           /* latched at start */
+    float start_slip_rad_s;        /* slip at inertia start */
+    float integral_Nm;             /* PI integral term */
+    float request_Nm;              /* last torque request */
+    float phase_start_request_Nm;  /* request when the lock-up hand-over began */
+    float filtered_torque_Nm;      /* jerk estimate filter state */
+    float error_sq_sum;            /* sum of squared slip errors over the inertia phase, (rad/s)^2 */
+    uint32_t inertia_periods;
+    wc_shift_report_t report;      /* running, final at the end */
+} wc_shift_t;
+
+void wc_shift_init(wc_shift_t *shift);
+
+/* The reference slip of the inertia phase (DESIGN 10) at elapsed_s after its
+ * start: start_slip * (1 - s(x)), s(x) = 3x^2 - 2x^3, x = elapsed / target
+ * clamped to [0, 1]; *rate_rad_s2 its time derivative (0 at both ends). */
+float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2);
+
+/* Feed-forward torque of the inertia phase, DESIGN 10 with the output side
+ * quasi-static over the phase (dw_o/dt ~ 0, so T_s ~ b T_c and the b terms
+ * cancel): T_ff = (T_t - I_t dref/dt / a) / a, >= 0. */
+float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2);
+
+/* One control period while the frame loop is in shift mode and not in its
+ * safe state (safe = true: the loop's safe state is active; a running shift
+ * aborts with WC_SHIFT_ABORT_INPUT_LOST). Builds the clutch input from
+ * sensors (slip and temperatures; mode and request are the controller's),
+ * steps the clutch (wc_clutch_step) and updates the quality vector. Returns
+ * true when the shift ended this step; *report then holds its quality vector. */
+bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                   bool safe, wc_clutch_t *clutch, const wc_step_input_t *sensors, wc_step_output_t *out,
+                   wc_shift_report_t *report);
+
+#endif /* WC_SHIFT_H */

@@ -1,0 +1,265 @@
+#include "wetclutch/wc_shift.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "wc_internal.h"
+
+/* A value in [lo, hi] (false for NaN). */
+static bool in_closed(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
+
+/* A time that is 0 (off) or within [1e-3, WC_SHIFT_LIMIT_TIME_MAX_s]. */
+static bool off_or_time(float value_s) { return in_closed(value_s, 0.0f, 0.0f) || in_closed(value_s, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s); }
+
+wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal)
+{
+    if (cal == NULL) { return WC_SHIFT_CAL_NULL; }
+    const float tmax = WC_SHIFT_LIMIT_TIME_MAX_s;
+    if (!in_closed(cal->turbine_inertia_kg_m2, 1e-4f, 100.0f)) { return WC_SHIFT_CAL_TURBINE_INERTIA; }
+    if (!in_closed(cal->turbine_ratio, 0.05f, 20.0f)) { return WC_SHIFT_CAL_TURBINE_RATIO; }
+    if (!in_closed(cal->jerk_per_torque_rate, 0.0f, 1.0f)) { return WC_SHIFT_CAL_JERK_PER_TORQUE_RATE; }
+    if (!in_closed(cal->prepare_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_PREPARE_TIME; }
+    if (!in_closed(cal->torque_phase_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_TORQUE_PHASE_TIME; }
+    if (!in_closed(cal->inertia_time_min_s, WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s, WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s)) {
+        return WC_SHIFT_CAL_INERTIA_TIME_MIN;
+    }
+    if (!in_closed(cal->inertia_time_max_s, cal->inertia_time_min_s, WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s)) {
+        return WC_SHIFT_CAL_INERTIA_TIME_MAX;
+    }
+    if (!in_closed(cal->inertia_timeout_factor, 1.05f, 10.0f)) { return WC_SHIFT_CAL_INERTIA_TIMEOUT_FACTOR; }
+    if (!in_closed(cal->lockup_ramp_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_LOCKUP_RAMP_TIME; }
+    if (!in_closed(cal->holding_torque_factor, 1.0f, 5.0f)) { return WC_SHIFT_CAL_HOLDING_TORQUE_FACTOR; }
+    if (!in_closed(cal->min_start_slip_rad_s, 0.0f, WC_SLIP_MAX_rad_s)) { return WC_SHIFT_CAL_MIN_START_SLIP; }
+    if (!in_closed(cal->feedforward_gain, 0.0f, 2.0f)) { return WC_SHIFT_CAL_FEEDFORWARD_GAIN; }
+    if (!in_closed(cal->kp_Nm_per_rad_s, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX)) { return WC_SHIFT_CAL_KP; }
+    if (!in_closed(cal->ki_Nm_per_rad, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX)) { return WC_SHIFT_CAL_KI; }
+    if (!in_closed(cal->integral_limit_Nm, 0.0f, WC_TORQUE_MAX_Nm)) { return WC_SHIFT_CAL_INTEGRAL_LIMIT; }
+    if (!off_or_time(cal->lag_compensation_time_s)) { return WC_SHIFT_CAL_LAG_COMPENSATION_TIME; }
+    if (cal->theta_source > (uint32_t)WC_SHIFT_THETA_OIL) { return WC_SHIFT_CAL_THETA_SOURCE; }
+    if (!in_closed(cal->flare_slip_rad_s, 0.0f, WC_SLIP_MAX_rad_s)) { return WC_SHIFT_CAL_FLARE_SLIP; }
+    if (!in_closed(cal->tie_up_factor, 1.0f, 10.0f)) { return WC_SHIFT_CAL_TIE_UP_FACTOR; }
+    if (!off_or_time(cal->jerk_filter_time_s)) { return WC_SHIFT_CAL_JERK_FILTER_TIME; }
+    return WC_SHIFT_CAL_OK;
+}
+
+void wc_shift_init(wc_shift_t *shift)
+{
+    WC_ASSERT(shift != NULL);
+    if (shift == NULL) { return; }
+    static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u,
+                                     { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u } };
+    *shift = idle;
+}
+
+float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
+{
+    /* DESIGN 10: smoothstep from the start slip to 0; zero slope at both ends,
+     * so the feed-forward (and the clutch torque) neither steps at the phase
+     * start nor at lock-up. */
+    float x = (target_time_s > 0.0f) ? (elapsed_s / target_time_s) : 1.0f;
+    x = (x > 0.0f) ? ((x < 1.0f) ? x : 1.0f) : 0.0f;  /* also NaN -> 0 */
+    if (rate_rad_s2 != NULL) {
+        *rate_rad_s2 = (target_time_s > 0.0f) ? (-6.0f * start_slip_rad_s * x * (1.0f - x) / target_time_s) : 0.0f;
+    }
+    return start_slip_rad_s * (1.0f - x * x * (3.0f - 2.0f * x));
+}
+
+float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2)
+{
+    /* DESIGN 10: T_ff = (a T_t / I_t + b T_s / I_o - dref/dt) / (a^2 / I_t + b^2 / I_o);
+     * with T_s = b T_c - I_o dw_o/dt and dw_o/dt ~ 0 the b terms cancel:
+     * T_ff = (T_t - I_t dref/dt / a) / a. */
+    const float a = cal->turbine_ratio;
+    const float t_ff = (turbine_torque_Nm - cal->turbine_inertia_kg_m2 * reference_rate_rad_s2 / a) / a;
+    return (t_ff > 0.0f) ? ((t_ff < WC_TORQUE_MAX_Nm) ? t_ff : WC_TORQUE_MAX_Nm) : 0.0f;
+}
+
+static uint32_t periods_of(float time_s, float dt_s)
+{
+    const float n = time_s / dt_s + 0.5f;  /* both checked: time <= 10 s, dt >= 1e-4 s */
+    return (uint32_t)n;
+}
+
+static bool running(uint32_t phase)
+{
+    return (phase == (uint32_t)WC_SHIFT_PREPARE) || (phase == (uint32_t)WC_SHIFT_TORQUE) ||
+           (phase == (uint32_t)WC_SHIFT_INERTIA) || (phase == (uint32_t)WC_SHIFT_LOCKUP);
+}
+
+static void enter(wc_shift_t *shift, wc_shift_phase_t phase)
+{
+    shift->phase = (uint32_t)phase;
+    shift->phase_periods = 0u;
+}
+
+static void abort_shift(wc_shift_t *shift, wc_shift_abort_t reason)
+{
+    enter(shift, WC_SHIFT_ABORTED);
+    shift->report.abort_reason = (uint32_t)reason;
+}
+
+static bool command_valid(const wc_shift_calibration_t *cal, const wc_shift_command_t *command)
+{
+    return (command->target_gear == 2u) &&
+           in_closed(command->target_inertia_time_s, cal->inertia_time_min_s, cal->inertia_time_max_s) &&
+           in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm);
+}
+
+static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s)
+{
+    wc_shift_init(shift);
+    shift->last_request = true;
+    shift->turbine_torque_Nm = command->turbine_torque_Nm;
+    shift->target_time_s = command->target_inertia_time_s;
+    shift->start_slip_rad_s = slip_rad_s;
+    shift->report.peak_theta_degC = WC_THETA_MIN_degC;
+    enter(shift, WC_SHIFT_PREPARE);
+}
+
+/* The torque request of this period (the phase's law); may change the phase. */
+static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s,
+                              float dt_s, bool saturated)
+{
+    const float share_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;  /* T_t / a */
+    if (shift->phase == (uint32_t)WC_SHIFT_PREPARE) {
+        if (shift->phase_periods < periods_of(cal->prepare_time_s, dt_s)) { return 0.0f; }
+        enter(shift, WC_SHIFT_TORQUE);
+    }
+    if (shift->phase == (uint32_t)WC_SHIFT_TORQUE) {
+        const uint32_t n = periods_of(cal->torque_phase_time_s, dt_s);
+        if (shift->phase_periods < n) {
+            return share_Nm * (float)(shift->phase_periods + 1u) / (float)n;
+        }
+        /* inertia phase: the reference starts at the measured slip; bumpless:
+         * the integral takes what the feed-forward does not give of the last request */
+        enter(shift, WC_SHIFT_INERTIA);
+        shift->start_slip_rad_s = slip_rad_s;
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, 0.0f);
+        if (!(slip_rad_s > cal->min_start_slip_rad_s)) {
+            abort_shift(shift, WC_SHIFT_ABORT_NO_SLIP);
+            return 0.0f;
+        }
+    }
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
+        float rate_rad_s2;
+        const float elapsed_s = (float)shift->phase_periods * dt_s;
+        const float reference = wc_shift_reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float ff_Nm = cal->feedforward_gain * wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, rate_rad_s2);
+        const float error = slip_rad_s - reference;  /* slip above the reference: more torque */
+        shift->error_sq_sum += error * error;
+        shift->inertia_periods++;
+        /* anti-windup: no integration further into a saturated request */
+        const bool blocked = (saturated && (error > 0.0f)) || ((shift->request_Nm <= 0.0f) && (error < 0.0f));
+        if (!blocked) {
+            const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error * dt_s;
+            const float limit = cal->integral_limit_Nm;
+            shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
+        }
+        if (slip_rad_s > shift->start_slip_rad_s + cal->flare_slip_rad_s) { shift->report.flare = true; }
+        if ((slip_rad_s >= shift->start_slip_rad_s) && (shift->request_Nm > cal->tie_up_factor * share_Nm)) {
+            shift->report.tie_up = true;  /* the turbine does not move although the clutch pulls hard: something holds it */
+        }
+        return ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
+    }
+    if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
+        const uint32_t n = periods_of(cal->lockup_ramp_time_s, dt_s);
+        const float hold_Nm = cal->holding_torque_factor * share_Nm;
+        const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
+        return shift->phase_start_request_Nm + (hold_Nm - shift->phase_start_request_Nm) * ((x < 1.0f) ? x : 1.0f);
+    }
+    /* LOCKED: hold */
+    return cal->holding_torque_factor * share_Nm;
+}
+
+bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                   bool safe, wc_clutch_t *clutch, const wc_step_input_t *sensors, wc_step_output_t *out,
+                   wc_shift_report_t *report)
+{
+    WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (sensors != NULL) &&
+              (out != NULL) && (report != NULL));
+    if ((shift == NULL) || (cal == NULL) || (command == NULL) || (clutch == NULL) || (sensors == NULL) ||
+        (out == NULL) || (report == NULL)) {
+        return false;
+    }
+    const uint32_t phase_before = shift->phase;
+    const bool edge = command->request && !shift->last_request;
+    shift->last_request = command->request;
+    const float dt_s = (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;
+    const float slip_rad_s = wc_slip_valid(sensors->slip_rad_s) ? sensors->slip_rad_s : clutch->held.slip_rad_s;
+    const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
+
+    /* Transitions on the command and the loop's state. */
+    if (safe || !command->request) {
+        if (running(shift->phase)) {
+            abort_shift(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
+        } else if (!command->request) {
+            enter(shift, WC_SHIFT_IDLE);
+        }
+    } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
+        start(shift, command, slip_rad_s);
+        if (!command_valid(cal, command)) { abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND); }
+    }
+    if (running(shift->phase) && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+        shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
+    }
+
+    wc_step_input_t in = *sensors;
+    in.mode = WC_MODE_OPEN;
+    in.torque_request_Nm = 0.0f;
+    in.lag_compensation_time_s = cal->lag_compensation_time_s;
+    in.theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
+    if (running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
+        float request_Nm = phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated);
+        request_Nm = (request_Nm > 0.0f) ? ((request_Nm < WC_TORQUE_MAX_Nm) ? request_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
+        if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
+            in.mode = WC_MODE_TORQUE;
+            in.torque_request_Nm = request_Nm;
+            shift->request_Nm = request_Nm;
+        }
+    }
+    (void)wc_clutch_step(clutch, &in, out);
+    const uint32_t phase_stepped = shift->phase;
+
+    /* After the step: the lock-up decides the inertia phase's end. */
+    const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
+        const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
+        if (locked) {
+            shift->report.inertia_time_s = elapsed_s;
+            shift->phase_start_request_Nm = shift->request_Nm;
+            enter(shift, WC_SHIFT_LOCKUP);
+        } else if (elapsed_s > shift->target_time_s * cal->inertia_timeout_factor) {
+            shift->report.inertia_time_s = elapsed_s;
+            abort_shift(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
+        }
+    } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
+        if (shift->phase_periods + 1u >= periods_of(cal->lockup_ramp_time_s, dt_s)) {
+            if (locked) { enter(shift, WC_SHIFT_LOCKED); }
+            else { abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED); }
+        }
+    }
+
+    /* Quality vector over the shift (command to its end). */
+    if (running(phase_before) || running(shift->phase)) {
+        wc_shift_report_t *q = &shift->report;
+        q->friction_energy_J += fabsf(out->model.torque_Nm * slip_rad_s) * dt_s;  /* eq. 1's heat input */
+        if (clutch->theta_degC > q->peak_theta_degC) { q->peak_theta_degC = clutch->theta_degC; }
+        const float alpha = dt_s / (cal->jerk_filter_time_s + dt_s);  /* first-order filter, exact for tau = 0 */
+        const float filtered = shift->filtered_torque_Nm + (out->model.torque_Nm - shift->filtered_torque_Nm) * alpha;
+        const float jerk = fabsf(cal->jerk_per_torque_rate * (filtered - shift->filtered_torque_Nm) / dt_s);
+        if (running(phase_before) && (jerk > q->peak_jerk_m_s3)) { q->peak_jerk_m_s3 = jerk; }  /* not the first sample */
+        shift->filtered_torque_Nm = filtered;
+    }
+    if (shift->phase == phase_stepped) {  /* a phase entered after the step starts counting at the next */
+        shift->phase_periods = (shift->phase_periods < UINT32_MAX) ? (shift->phase_periods + 1u) : UINT32_MAX;
+    }
+
+    const bool ended = (phase_before != shift->phase) &&
+                       ((shift->phase == (uint32_t)WC_SHIFT_LOCKED) || (shift->phase == (uint32_t)WC_SHIFT_ABORTED));
+    if (ended) {
+        shift->report.slip_rmse_rad_s = (shift->inertia_periods > 0u)
+                                            ? sqrtf(shift->error_sq_sum / (float)shift->inertia_periods) : 0.0f;
+        *report = shift->report;
+    }
+    return ended;
+}

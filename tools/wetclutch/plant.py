@@ -1,0 +1,630 @@
+"""The 1->2 upshift plant (DESIGN 10): a closed-loop simulator for the shift controller.
+
+The reduced driveline of DESIGN 10 with BOTH shift elements, stepped at the
+TCU's period (dt = 1 ms) with the VFS current held over the step:
+
+    I_t dw_t/dt = T_t - a T_c - a1 T_off            turbine + engine (converter locked)
+    I_o dw_o/dt = b T_c + b1 T_off - T_s            output shaft
+    T_s = k_s phi_s + c_s (w_o - r_f w_w),  dphi_s/dt = w_o - r_f w_w   (driveshaft, referred to the output shaft)
+    I_v dw_w/dt = r_f T_s - T_road                  vehicle, I_v = m r_w^2
+    T_road = r_w (m g (c_rr cos g + sin g) + rho c_d A v |v| / 2)
+
+On-coming (2nd-gear) clutch: slip = a w_t - b w_o, a = 1, b = i2; off-going
+(1st-gear) clutch: slip_off = a1 w_t - b1 w_o, a1 = 1, b1 = i1. A clutch torque
+is positive when it opposes positive slip (drive torque from the turbine to the
+output). In 1st gear the off-going clutch is locked and the on-coming clutch
+slips at (i1 - i2) w_o > 0; in the inertia phase the turbine falls, so slip_off
+becomes negative: an off-going clutch not yet released then carries negative
+torque (it fights the shift: tie-up).
+
+The on-coming clutch is the TRUE clutch of the bench (bench._Physics with the
+true calibration): eq. 8 torque from the nominal separation h (eq. 9, 15) at
+|slip| and the true friction-surface temperature, the Coulomb part (and the
+static capacity) times friction_scale; the Reynolds squeeze film advances h
+under the apply force F = P A_p - F_s (>= 0) of the lagged piston pressure
+(first-order VFS lag, exact within the step); the static capacity
+static_friction_factor mu_f(0, theta) R_eff N_c F_c for its lock-up; its heat
+into the lumped pack of eq. 1 (true k1, k2, C; exact zero-order hold with the
+step's mean friction power, as bench.simulate), oil and housing held.
+
+The off-going clutch: Coulomb, static capacity holding_factor x max(|T_t|,
+the torque it carries at the start, holding_min), kinetic capacity
+kinetic_ratio x that; scripted release: full until release_start after the
+shift command, then linearly to 0 over release_time.
+
+Stick-slip (each clutch): a locked clutch carries the torque the rigid
+constraint needs (the constrained two-inertia system solved for it, the other
+clutch's torque known) while that is within its static capacity, else it breaks
+away and slips in the direction of the excess; a slipping clutch locks when its
+slip crosses zero and the torque to hold it is within the static capacity (the
+remaining slip removed by the momentum-conserving impulse). Both locked at once
+is only possible at standstill (i1 != i2): a clutch whose slip crosses zero
+while the other is locked keeps slipping (chatters about zero slip).
+
+Integration: SUBSTEPS = 4 substeps of 0.25 ms per period, semi-implicit
+(symplectic) Euler for the mechanics (largest rates: the driveshaft against the
+output inertia alone, 110 rad/s, and the viscous slip damping up to about
+500 1/s: below 0.13 per substep), classical RK4 for the film in each substep
+with the pressure exact, the temperature held over the period. The initial state
+is steady 1st gear under the turbine torque: all inertias accelerating together,
+the driveshaft pre-wound to the torque that acceleration needs, the open
+on-coming clutch's drag (film at h_max) included, pressure 0.
+
+Deterministic: same parameters, arguments and seed -> bit-identical truth and
+sensor values (plain float arithmetic, one seeded numpy Generator drawn in blocks).
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from . import calibration, model
+from .bench import _Physics
+
+RPM = model.RAD_S_PER_RPM          # rad/s per rpm
+DT_S = 1e-3
+SUBSTEPS = 4
+GRAVITY = 9.81
+NOISE_BLOCK = 1000
+DEFAULT_PLANT = Path(__file__).resolve().parents[1] / "plants" / "upshift_1_2.toml"
+
+
+class PlantError(Exception):
+    """A plant file that cannot be used; the message names the file and the parameter."""
+
+
+# (section, name, unit, constraint). Constraints: pos (> 0), nonneg (>= 0), finite, seed (whole number >= 0).
+SCHEMA: tuple[tuple[str, str, str, str], ...] = (
+    ("clutch", "friction_scale", "1", "pos"),
+    ("clutch", "housing_offset", "K", "finite"),
+    ("driveline", "turbine_inertia", "kg*m^2", "pos"),
+    ("driveline", "output_inertia", "kg*m^2", "pos"),
+    ("driveline", "ratio_1st", "1", "pos"),
+    ("driveline", "ratio_2nd", "1", "pos"),
+    ("driveline", "final_drive", "1", "pos"),
+    ("driveline", "shaft_stiffness", "N*m/rad", "pos"),
+    ("driveline", "shaft_damping", "N*m*s/rad", "nonneg"),
+    ("driveline", "wheel_radius", "m", "pos"),
+    ("driveline", "vehicle_mass", "kg", "pos"),
+    ("driveline", "rolling_resistance", "1", "nonneg"),
+    ("driveline", "drag_area", "m^2", "nonneg"),
+    ("driveline", "air_density", "kg/m^3", "nonneg"),
+    ("driveline", "road_grade", "%", "finite"),
+    ("offgoing", "holding_factor", "1", "pos"),
+    ("offgoing", "holding_min", "N*m", "nonneg"),
+    ("offgoing", "kinetic_ratio", "1", "pos"),
+    ("offgoing", "release_start", "s", "nonneg"),
+    ("offgoing", "release_time", "s", "pos"),
+    ("hydraulics", "vfs_gain", "Pa/mA", "pos"),
+    ("hydraulics", "vfs_time_constant", "s", "pos"),
+    ("hydraulics", "pressure_noise", "Pa", "nonneg"),
+    ("sensors", "slip_noise", "rpm", "nonneg"),
+    ("sensors", "slip_resolution", "rpm", "pos"),
+    ("sensors", "temperature_noise", "K", "nonneg"),
+    ("sensors", "temperature_resolution", "K", "pos"),
+    ("sensors", "torque_estimate_bias", "1", "finite"),
+    ("sensors", "torque_estimate_noise", "N*m", "nonneg"),
+    ("scenario", "turbine_speed", "rpm", "pos"),
+    ("scenario", "preroll_time", "s", "nonneg"),
+    ("scenario", "shift_duration", "s", "pos"),
+    ("scenario", "turbine_torque_full", "N*m", "pos"),
+    ("scenario", "oil_temperature", "degC", "finite"),
+    ("scenario", "seed", "1", "seed"),
+)
+
+# Narrower physical ranges (inclusive): (low, high).
+RANGES = {
+    "friction_scale": (0.2, 5.0),
+    "housing_offset": (-100.0, 100.0),
+    "kinetic_ratio": (0.1, 1.0),
+    "road_grade": (-30.0, 30.0),
+    "vfs_time_constant": (1e-4, 10.0),
+    "turbine_speed": (0.0, 8000.0),
+    "oil_temperature": (-40.0, 150.0),
+    "torque_estimate_bias": (-0.5, 0.5),
+}
+
+
+@dataclass(frozen=True)
+class PlantParams:
+    """A validated plant file (SI units except where the name says: rpm, %, degC)."""
+
+    clutch_cal: calibration.Calibration     # the TRUE on-coming clutch
+    calibration_path: str
+    friction_scale: float
+    housing_offset: float
+    turbine_inertia: float
+    output_inertia: float
+    ratio_1st: float
+    ratio_2nd: float
+    final_drive: float
+    shaft_stiffness: float
+    shaft_damping: float
+    wheel_radius: float
+    vehicle_mass: float
+    rolling_resistance: float
+    drag_area: float
+    air_density: float
+    road_grade: float
+    holding_factor: float
+    holding_min: float
+    kinetic_ratio: float
+    release_start: float
+    release_time: float
+    vfs_gain: float
+    vfs_time_constant: float
+    pressure_noise: float
+    slip_noise: float
+    slip_resolution: float
+    temperature_noise: float
+    temperature_resolution: float
+    torque_estimate_bias: float
+    torque_estimate_noise: float
+    turbine_speed: float
+    preroll_time: float
+    shift_duration: float
+    turbine_torque_full: float
+    oil_temperature: float
+    seed: int
+    sources: dict = field(default_factory=dict, compare=False)
+    path: str = ""
+
+
+_FIELDS = {f.name for f in fields(PlantParams)}
+assert {n for _, n, _, _ in SCHEMA} <= _FIELDS
+
+
+def load_plant(path) -> PlantParams:
+    """Read and validate a plant file (every parameter { value, unit, source }; [clutch].calibration a
+    path relative to the plant file). Raises PlantError naming the file and the parameter."""
+    path = Path(path)
+    where = str(path)
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except OSError as e:
+        raise PlantError(f"{where}: cannot read plant file: {e.strerror or e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise PlantError(f"{where}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise PlantError(f"{where}: not UTF-8 text (byte {e.start}): not a plant file") from None
+
+    known = {(s, n) for s, n, _, _ in SCHEMA} | {("clutch", "calibration")}
+    sections = {s for s, _ in known}
+    for section, table in doc.items():
+        if section not in sections:
+            raise PlantError(f"{where}: unknown section [{section}]")
+        if not isinstance(table, dict):
+            raise PlantError(f"{where}: '{section}' must be a table of parameters")
+        for name in table:
+            if (section, name) not in known:
+                raise PlantError(f"{where}: unknown parameter '{section}.{name}'")
+
+    values: dict = {}
+    sources: dict = {}
+    cal_entry = doc.get("clutch", {}).get("calibration")
+    if cal_entry is None:
+        raise PlantError(f"{where}: missing parameter 'clutch.calibration' (path of the true clutch calibration)")
+    if not isinstance(cal_entry, str) or not cal_entry.strip():
+        raise PlantError(f"{where}: parameter 'clutch.calibration' must be a path string (relative to the plant file)")
+    cal_path = (path.parent / cal_entry).resolve()
+    try:
+        cal = calibration.load(cal_path)
+    except calibration.CalibrationError as e:
+        raise PlantError(f"{where}: parameter 'clutch.calibration': {e}") from None
+
+    for section, name, unit, constraint in SCHEMA:
+        q = f"{section}.{name}"
+        entry = doc.get(section, {}).get(name)
+        if entry is None:
+            raise PlantError(f"{where}: missing parameter '{q}' (unit {unit})")
+        if not isinstance(entry, dict) or "value" not in entry:
+            raise PlantError(f"{where}: parameter '{q}' must be {{ value = ..., unit = \"{unit}\", source = \"...\" }}")
+        extra = set(entry) - {"value", "unit", "source"}
+        if extra:
+            raise PlantError(f"{where}: parameter '{q}': unknown key(s) {', '.join(sorted(extra))}")
+        if entry.get("unit") != unit:
+            raise PlantError(f"{where}: parameter '{q}': unit {entry.get('unit')!r}, expected {unit!r}")
+        src = entry.get("source")
+        if not isinstance(src, str) or not src.strip():
+            raise PlantError(f"{where}: parameter '{q}': missing 'source' (reference or reasoning)")
+        raw = entry["value"]
+        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+            raise PlantError(f"{where}: parameter '{q}': value {raw!r} is not a number")
+        v = float(raw)
+        if not math.isfinite(v):
+            raise PlantError(f"{where}: parameter '{q}': value {raw!r} is not finite")
+        if constraint == "pos" and not v > 0:
+            raise PlantError(f"{where}: parameter '{q}': value {raw!r} must be > 0 {unit}")
+        if constraint == "nonneg" and not v >= 0:
+            raise PlantError(f"{where}: parameter '{q}': value {raw!r} must be >= 0 {unit}")
+        if constraint == "seed":
+            if v != int(v) or v < 0:
+                raise PlantError(f"{where}: parameter '{q}': value {raw!r} must be a whole number >= 0")
+            v = int(v)
+        if name in RANGES:
+            lo, hi = RANGES[name]
+            if not lo <= v <= hi:
+                raise PlantError(f"{where}: parameter '{q}': value {raw!r} must be in [{lo:g}, {hi:g}] {unit}")
+        values[name] = v
+        sources[name] = src
+
+    if not values["ratio_1st"] > values["ratio_2nd"]:
+        raise PlantError(f"{where}: parameter 'driveline.ratio_2nd' must be < driveline.ratio_1st (an upshift)")
+    if not values["turbine_speed"] * RPM / values["ratio_1st"] > 0:
+        raise PlantError(f"{where}: parameter 'scenario.turbine_speed' must be > 0 rpm")
+    return PlantParams(clutch_cal=cal, calibration_path=str(cal_path), sources=sources, path=where, **values)
+
+
+TRUTH_NAMES = (
+    "t_s",                      # s, plant time (0 at construction)
+    "turbine_speed_rpm", "output_speed_rpm",
+    "gear1_speed_rpm",          # i1 w_o: the turbine speed 1st gear would have (Fig. 4)
+    "gear2_speed_rpm",          # i2 w_o: the turbine speed 2nd gear would have
+    "vehicle_speed_m_s",
+    "slip_rad_s",               # true on-coming slip w_t - i2 w_o
+    "offgoing_slip_rad_s",      # w_t - i1 w_o
+    "clutch_torque_Nm",         # on-coming, signed (> 0 opposes positive slip: drives the output)
+    "clutch_capacity_Nm",       # on-coming static capacity (friction_scale included)
+    "offgoing_torque_Nm", "offgoing_capacity_Nm",
+    "driveshaft_torque_Nm",     # T_s at the output shaft
+    "turbine_torque_Nm",        # true T_t
+    "current_mA",               # the current held over the step (clamped to the solenoid range)
+    "pressure_cmd_Pa",          # K i
+    "pressure_Pa",              # true piston pressure after the lag (ripple excluded)
+    "apply_force_N",            # P A_p - F_s >= 0 (end of step, ripple excluded)
+    "contact_force_N", "separation_m", "hbar_m",
+    "theta_clutch_degC",        # true friction-surface temperature
+    "vehicle_accel_m_s2",
+    "oncoming_locked", "offgoing_locked",   # 0.0 / 1.0
+    "friction_power_W",         # on-coming, mean over the step (the heat into eq. 1)
+    "offgoing_power_W",         # off-going, mean over the step
+)
+
+
+class UpshiftPlant:
+    """The 1->2 upshift plant; see the module docstring. One instance per shift."""
+
+    def __init__(self, params: PlantParams, *, oil_degC: float, turbine_torque_Nm: float,
+                 friction_scale: float | None = None, seed: int | None = None,
+                 theta_clutch_degC: float | None = None, turbine_speed_rpm: float | None = None):
+        p = params
+        cal = p.clutch_cal
+        for name, v in (("oil_degC", oil_degC), ("turbine_torque_Nm", turbine_torque_Nm)):
+            if not math.isfinite(float(v)):
+                raise ValueError(f"{name} {v!r} is not finite")
+        self.params = p
+        self.dt_s = DT_S
+        self.n_sub = SUBSTEPS
+        self.hs = DT_S / SUBSTEPS
+        self.oil_degC = float(oil_degC)
+        self.housing_degC = self.oil_degC + p.housing_offset
+        self.turbine_torque_Nm = float(turbine_torque_Nm)     # may be changed between steps
+        self.friction_scale = p.friction_scale if friction_scale is None else float(friction_scale)
+        if not self.friction_scale > 0:
+            raise ValueError(f"friction_scale {friction_scale!r} must be > 0")
+        seed = p.seed if seed is None else int(seed)
+        self.rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, 0x12])))
+        self._noise = None
+        self._noise_k = NOISE_BLOCK
+
+        # The true clutch (bench physics constants).
+        ph = _Physics(cal, DT_S, 1.0, 1)
+        self._ph = ph
+        self._phi = ph.phi
+        self._film_table = model.FilmTable(cal, 4001) if ph.phi == 0.0 else None
+        self.a_p, self.f_s = cal.piston_area, cal.return_spring_force
+        self.i_min, self.i_max = cal.vfs_current_min, cal.vfs_current_max
+        self.k1, self.k2, self.cap = cal.oil_conductance, cal.housing_conductance, cal.heat_capacity
+        self.a_th = math.exp(-(self.k1 + self.k2) * DT_S / self.cap)
+        self.visc_k = ph.rn * ph.area * ph.r_eff            # viscous torque = visc_k mu_v |w| / h_bar
+        self.i1, self.i2, self.rf = p.ratio_1st, p.ratio_2nd, p.final_drive
+        self.It, self.Io = p.turbine_inertia, p.output_inertia
+        self.Iv = p.vehicle_mass * p.wheel_radius ** 2
+        self.ks, self.cs = p.shaft_stiffness, p.shaft_damping
+        g = math.atan(p.road_grade / 100.0)
+        self.road_const = p.wheel_radius * p.vehicle_mass * GRAVITY * math.sin(g)
+        self.road_roll = p.wheel_radius * p.vehicle_mass * GRAVITY * p.rolling_resistance * math.cos(g)
+        self.road_drag = p.wheel_radius ** 3 * 0.5 * p.air_density * p.drag_area   # x w_w |w_w|
+        self.m_on = 1.0 / self.It + self.i2 * self.i2 / self.Io      # slip "mobility" of each clutch
+        self.m_off = 1.0 / self.It + self.i1 * self.i1 / self.Io
+        self.lag = [math.exp(-j * 0.5 * self.hs / p.vfs_time_constant) for j in range(2 * SUBSTEPS + 1)]
+
+        # Initial state: steady 1st gear, on-coming open (h at h_max), pressure 0.
+        self.t = 0.0
+        self.P = 0.0
+        self.h = ph.h_max
+        self.theta = self.oil_degC if theta_clutch_degC is None else float(theta_clutch_degC)
+        self._set_theta(self.theta)
+        self._set_film(self.h)
+        w_t = (p.turbine_speed if turbine_speed_rpm is None else float(turbine_speed_rpm)) * RPM
+        if not w_t > 0:
+            raise ValueError(f"turbine_speed_rpm {turbine_speed_rpm!r} must be > 0")
+        self.wo = w_t / self.i1
+        self.wt = w_t
+        self.ww = self.wo / self.rf
+        t_on = self._on_kinetic(abs(self.wt - self.i2 * self.wo))
+        tt = self.turbine_torque_Nm
+        j_w = self.Iv + self.rf ** 2 * (self.Io + self.It * self.i1 ** 2)
+        alpha = (self.rf * (self.i1 * tt - (self.i1 - self.i2) * t_on) - self._road(self.ww)) / j_w
+        t_s = (self.Iv * alpha + self._road(self.ww)) / self.rf
+        self.phi = t_s / self.ks
+        t_off0 = tt - t_on - self.It * self.i1 * self.rf * alpha
+        self.off_static = p.holding_factor * max(abs(tt), abs(t_off0), p.holding_min)
+        self.lock_on, self.lock_off = False, True
+        self.dir_on, self.dir_off = 1.0, 1.0
+        self.current = 0.0
+        self.p_noise = 0.0
+        self.power_on = self.power_off = 0.0
+        self._rows: list = []
+        self._draw_noise()
+        self._truth = self._make_truth(None)
+        self._rows.append(tuple(self._truth[c] for c in TRUTH_NAMES))
+
+    # ----------------------------------------------------------------- clutch physics (scalar forms of _Physics)
+    def _set_theta(self, theta):
+        ph = self._ph
+        self.mu_v = float(ph.viscosity(theta))
+        self.temp = 1.0 + ph.mu3_th2 * (theta - ph.th1)
+        self.rate_mu = ph.rate_k / self.mu_v if self._phi > 0.0 else 0.0
+
+    def _set_film(self, h):
+        """F_c, h_bar and the static capacity at separation h (eq. 9, 15; DESIGN 9)."""
+        ph = self._ph
+        x = h * ph.inv_s_sqrt2
+        ex = math.exp(-x * x)
+        self.f_c = ph.pc_area * (ex - h * ph.pc_lin * math.erfc(x))
+        self.hbar = 0.5 * h * (1.0 + math.erf(x)) + ph.hbar_k * ex
+        self.on_static = self.friction_scale * ph.static_factor * ph.rn * ph.mu2 * self.temp * self.f_c
+        self.coul_k = self.friction_scale * ph.rn * self.temp * self.f_c
+        self.visc_c = self.visc_k * self.mu_v / self.hbar
+
+    def _on_kinetic(self, w_abs):
+        """|T| of the slipping on-coming clutch at |slip| w_abs (eq. 8, 18; Coulomb part scaled)."""
+        ph = self._ph
+        return self.coul_k * (ph.mu1 + ph.dmu * math.exp(-ph.r_eff * w_abs / ph.vs)) + self.visc_c * w_abs
+
+    def _film_rate(self, h, f_app):
+        ph = self._ph
+        x = h * ph.inv_s_sqrt2
+        ex = math.exp(-x * x)
+        f_c = ph.pc_area * (ex - h * ph.pc_lin * math.erfc(x))
+        slope2 = math.erfc(-x)
+        hb = 0.5 * h * slope2 + ph.hbar_k * ex
+        return self.rate_mu * (f_c - f_app) * (hb * hb * hb / slope2)
+
+    def _force(self, P):
+        f = P * self.a_p - self.f_s
+        return f if f > 0.0 else 0.0
+
+    def _road(self, ww):
+        roll = self.road_roll * max(-1.0, min(1.0, ww * self.params.wheel_radius / 0.05))
+        return self.road_const + roll + self.road_drag * ww * abs(ww)
+
+    def _off_fraction(self, s):
+        p = self.params
+        if s is None or s <= p.release_start:
+            return 1.0
+        return max(0.0, 1.0 - (s - p.release_start) / p.release_time)
+
+    # ----------------------------------------------------------------- mechanics
+    def _torques(self, off_static, commit):
+        """(T_on, T_off, T_s, T_road) at the current state; a locked clutch whose needed torque exceeds its
+        static capacity breaks away (state changed only if commit)."""
+        wt, wo = self.wt, self.wo
+        i1, i2, It, Io = self.i1, self.i2, self.It, self.Io
+        t_s = self.ks * self.phi + self.cs * (wo - self.rf * self.ww)
+        tt = self.turbine_torque_Nm
+        lock_on, lock_off = self.lock_on, self.lock_off
+        off_kin = self.params.kinetic_ratio * off_static
+        if lock_on:
+            t_off = self._off_slipping(wt - i1 * wo) * off_kin
+            need = ((tt - t_off) / It - i2 * (i1 * t_off - t_s) / Io) / self.m_on
+            if abs(need) <= self.on_static:
+                t_on = need
+            else:
+                d = 1.0 if need > 0 else -1.0
+                t_on = d * self._on_kinetic(0.0)
+                if commit:
+                    self.lock_on, self.dir_on = False, d
+        elif lock_off:
+            s_on = wt - i2 * wo
+            t_on = (1.0 if s_on > 0 else -1.0 if s_on < 0 else self.dir_on) * self._on_kinetic(abs(s_on))
+            need = ((tt - t_on) / It - i1 * (i2 * t_on - t_s) / Io) / self.m_off
+            if abs(need) <= off_static:
+                t_off = need
+            else:
+                d = 1.0 if need > 0 else -1.0
+                t_off = d * off_kin
+                if commit:
+                    self.lock_off, self.dir_off = False, d
+        else:
+            s_on = wt - i2 * wo
+            t_on = (1.0 if s_on > 0 else -1.0 if s_on < 0 else self.dir_on) * self._on_kinetic(abs(s_on))
+            t_off = self._off_slipping(wt - i1 * wo) * off_kin
+        return t_on, t_off, t_s, self._road(self.ww)
+
+    def _off_slipping(self, s):
+        return 1.0 if s > 0 else -1.0 if s < 0 else self.dir_off
+
+    def _try_lock(self, which, off_static, t_other):
+        """A slipping clutch whose slip crossed zero: lock if the torque to hold it is within its capacity
+        (the other clutch slipping with torque t_other); remove the remaining slip by an impulse."""
+        i1, i2, It, Io = self.i1, self.i2, self.It, self.Io
+        tt = self.turbine_torque_Nm
+        t_s = self.ks * self.phi + self.cs * (self.wo - self.rf * self.ww)
+        if which == "on":
+            if self.lock_off:
+                return
+            need = ((tt - t_other) / It - i2 * (i1 * t_other - t_s) / Io) / self.m_on
+            if abs(need) <= self.on_static:
+                j = (self.wt - i2 * self.wo) / self.m_on
+                self.wt -= j / It
+                self.wo += i2 * j / Io
+                self.lock_on = True
+        else:
+            if self.lock_on:
+                return
+            need = ((tt - t_other) / It - i1 * (i2 * t_other - t_s) / Io) / self.m_off
+            if abs(need) <= off_static:
+                j = (self.wt - i1 * self.wo) / self.m_off
+                self.wt -= j / It
+                self.wo += i1 * j / Io
+                self.lock_off = True
+
+    # ----------------------------------------------------------------- public
+    def step(self, current_mA: float, shift_time_s: float | None) -> None:
+        """Advance one period (dt_s) with current_mA held; shift_time_s = time since the shift command at
+        the start of the step (None before the command), which drives the off-going clutch's release."""
+        i = float(current_mA)
+        if not math.isfinite(i):
+            raise ValueError(f"current_mA {current_mA!r} is not finite")
+        i = min(max(i, self.i_min), self.i_max)
+        p = self.params
+        hs, n = self.hs, self.n_sub
+        p_cmd = p.vfs_gain * i
+        dp = self.P - p_cmd
+        ripple = self.p_noise
+        lag = self.lag
+        i1, i2, rf = self.i1, self.i2, self.rf
+        It, Io, Iv = self.It, self.Io, self.Iv
+        e_on = e_off = 0.0
+        for j in range(n):
+            # film: one RK4 step over the substep, the pressure exact (first-order lag) within it
+            f0 = self._force(p_cmd + dp * lag[2 * j] + ripple)
+            fm = self._force(p_cmd + dp * lag[2 * j + 1] + ripple)
+            f1 = self._force(p_cmd + dp * lag[2 * j + 2] + ripple)
+            h = self.h
+            if self._phi == 0.0:
+                h = float(self._film_table.separation_from_pressure_m(f1 / self._ph.area))
+            elif not (h >= self._ph.h_max and f0 == 0.0 and fm == 0.0 and f1 == 0.0):
+                k1 = self._film_rate(h, f0)
+                k2 = self._film_rate(h + 0.5 * hs * k1, fm)
+                k3 = self._film_rate(h + 0.5 * hs * k2, fm)
+                k4 = self._film_rate(h + hs * k3, f1)
+                h = min(max(h + (hs / 6.0) * (k1 + 2.0 * (k2 + k3) + k4), self._ph.h_min), self._ph.h_max)
+            # mechanics at the substep start (film at the start), semi-implicit Euler
+            off_static = self.off_static * self._off_fraction(None if shift_time_s is None else shift_time_s + j * hs)
+            t_on, t_off, t_s, t_road = self._torques(off_static, True)
+            s_on0 = self.wt - i2 * self.wo
+            s_off0 = self.wt - i1 * self.wo
+            if not self.lock_on:
+                e_on += abs(t_on * s_on0)
+            if not self.lock_off:
+                e_off += abs(t_off * s_off0)
+            tt = self.turbine_torque_Nm
+            self.wt += hs * (tt - t_on - t_off) / It
+            self.wo += hs * (i2 * t_on + i1 * t_off - t_s) / Io
+            self.ww += hs * (rf * t_s - t_road) / Iv
+            if self.lock_on:      # keep the constraint exact against rounding
+                jj = (self.wt - i2 * self.wo) / self.m_on
+                self.wt -= jj / It
+                self.wo += i2 * jj / Io
+            elif self.lock_off:
+                jj = (self.wt - i1 * self.wo) / self.m_off
+                self.wt -= jj / It
+                self.wo += i1 * jj / Io
+            self.phi += hs * (self.wo - rf * self.ww)
+            if h != self.h:
+                self.h = h
+                self._set_film(h)
+            # lock-up: a slipping clutch whose slip crossed zero
+            if not self.lock_on:
+                s = self.wt - i2 * self.wo
+                if s != 0.0:
+                    self.dir_on = 1.0 if s > 0 else -1.0
+                if s * s_on0 <= 0.0 and s_on0 != 0.0:
+                    self._try_lock("on", off_static, t_off)
+            if not self.lock_off:
+                s = self.wt - i1 * self.wo
+                if s != 0.0:
+                    self.dir_off = 1.0 if s > 0 else -1.0
+                if s * s_off0 <= 0.0 and s_off0 != 0.0:
+                    self._try_lock("off", off_static, t_on)
+        # pressure lag (exact), heat into the pack (eq. 1, exact ZOH with the step's mean power)
+        self.P = p_cmd + dp * lag[2 * n]
+        self.current = i
+        self.power_on = e_on / n
+        self.power_off = e_off / n
+        th_ss = (self.power_on + self.k1 * self.oil_degC + self.k2 * self.housing_degC) / (self.k1 + self.k2)
+        self.theta = th_ss + (self.theta - th_ss) * self.a_th
+        self._set_theta(self.theta)
+        self._set_film(self.h)
+        self.t += DT_S
+        self._draw_noise()
+        self._truth = self._make_truth(shift_time_s if shift_time_s is None else shift_time_s + DT_S)
+        self._rows.append(tuple(self._truth[c] for c in TRUTH_NAMES))
+
+    def _draw_noise(self):
+        """Noise for the state just reached: slip, oil, housing, torque estimate, pressure ripple of the
+        next step. Drawn in blocks (cheap, deterministic)."""
+        if self._noise_k >= NOISE_BLOCK:
+            self._noise = self.rng.standard_normal((NOISE_BLOCK, 5)).tolist()
+            self._noise_k = 0
+        z = self._noise[self._noise_k]
+        self._noise_k += 1
+        p = self.params
+        q = p.slip_resolution
+        slip_rpm = (self.wt - self.i2 * self.wo) / RPM + p.slip_noise * z[0]
+        tq = p.temperature_resolution
+        self._sensors = {
+            "slip_rpm": round(slip_rpm / q) * q,
+            "oil_degC": round((self.oil_degC + p.temperature_noise * z[1]) / tq) * tq,
+            "housing_degC": round((self.housing_degC + p.temperature_noise * z[2]) / tq) * tq,
+            "turbine_torque_estimate_Nm": self.turbine_torque_Nm * (1.0 + p.torque_estimate_bias)
+            + p.torque_estimate_noise * z[3],
+        }
+        self.p_noise = p.pressure_noise * z[4]
+
+    def _make_truth(self, shift_time_s):
+        off_static = self.off_static * self._off_fraction(shift_time_s)
+        t_on, t_off, t_s, t_road = self._torques(off_static, False)
+        wo = self.wo
+        return {
+            "t_s": self.t,
+            "turbine_speed_rpm": self.wt / RPM,
+            "output_speed_rpm": wo / RPM,
+            "gear1_speed_rpm": self.i1 * wo / RPM,
+            "gear2_speed_rpm": self.i2 * wo / RPM,
+            "vehicle_speed_m_s": self.ww * self.params.wheel_radius,
+            "slip_rad_s": self.wt - self.i2 * wo,
+            "offgoing_slip_rad_s": self.wt - self.i1 * wo,
+            "clutch_torque_Nm": t_on,
+            "clutch_capacity_Nm": self.on_static,
+            "offgoing_torque_Nm": t_off,
+            "offgoing_capacity_Nm": off_static,
+            "driveshaft_torque_Nm": t_s,
+            "turbine_torque_Nm": self.turbine_torque_Nm,
+            "current_mA": self.current,
+            "pressure_cmd_Pa": self.params.vfs_gain * self.current,
+            "pressure_Pa": self.P,
+            "apply_force_N": self._force(self.P),
+            "contact_force_N": self.f_c,
+            "separation_m": self.h,
+            "hbar_m": self.hbar,
+            "theta_clutch_degC": self.theta,
+            "vehicle_accel_m_s2": self.params.wheel_radius * (self.rf * t_s - t_road) / self.Iv,
+            "oncoming_locked": float(self.lock_on),
+            "offgoing_locked": float(self.lock_off),
+            "friction_power_W": self.power_on,
+            "offgoing_power_W": self.power_off,
+        }
+
+    def sensors(self) -> dict:
+        """What the TCU receives this period (the state now): slip_rpm (noisy, 0.25 rpm steps), oil_degC,
+        housing_degC (0.1 degC steps), turbine_torque_estimate_Nm (biased, noisy). Idempotent."""
+        return dict(self._sensors)
+
+    @property
+    def truth(self) -> dict:
+        """The true state now (after the last step): TRUTH_NAMES."""
+        return dict(self._truth)
+
+    def record(self) -> dict:
+        """Every truth channel per period, the initial state first: {name: numpy array}."""
+        arr = np.array(self._rows, dtype=float)
+        return {c: arr[:, k].copy() for k, c in enumerate(TRUTH_NAMES)}
