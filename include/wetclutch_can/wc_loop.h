@@ -188,10 +188,15 @@ typedef enum {
 uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
                          wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
-/* Receive filter ids for the port: the control frames, then BenchMeasurement,
- * which a port passes only when bench input is enabled (count - 1 otherwise). */
+/* All ids the loop can receive: the control frames, ShiftCommand (used only
+ * with config.shift), BenchMeasurement (only with bench_input_enabled). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
                          WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
 #define WC_LOOP_RX_ID_COUNT 4u
+
+/* The receive filter of a port for this configuration: writes the ids the
+ * loop uses (of WC_LOOP_RX_IDS) to ids and returns their count; a port
+ * filters out the rest (they would count as unknown ids). */
+uint32_t wc_loop_rx_ids(const wc_loop_config_t *config, uint32_t ids[WC_LOOP_RX_ID_COUNT]);
 
 #endif /* WC_LOOP_H */

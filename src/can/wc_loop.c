@@ -373,3 +373,15 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
     }
     return step_now ? wc_loop_step(loop, out) : 0u;
 }
+
+uint32_t wc_loop_rx_ids(const wc_loop_config_t *config, uint32_t ids[WC_LOOP_RX_ID_COUNT])
+{
+    WC_ASSERT((config != NULL) && (ids != NULL));
+    if ((config == NULL) || (ids == NULL)) { return 0u; }
+    uint32_t n = 0u;
+    ids[n++] = WC_CAN_CLUTCH_SENSORS_FRAME_ID;
+    ids[n++] = WC_CAN_TORQUE_REQUEST_FRAME_ID;
+    if (config->shift != NULL) { ids[n++] = WC_CAN_SHIFT_COMMAND_FRAME_ID; }
+    if (config->bench_input_enabled) { ids[n++] = WC_CAN_BENCH_MEASUREMENT_FRAME_ID; }
+    return n;
+}

@@ -1,6 +1,15 @@
 /* wc_replay: the TCU's frame loop linked in-process, without SocketCAN.
  *
- *   wc_replay LOG [--bench] [--calibration NAME]
+ *   wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC]
+ *             [--shift NAME [--set FIELD=VALUE]...] [--lockstep]
+ *
+ * LOG "-" reads standard input. --shift turns shift control on with a
+ * compiled-in shift calibration (as wc_tcu --shift); --set overrides one of
+ * its float fields (the C name, e.g. kp_Nm_per_rad_s=4: the feedback-gain
+ * search of `wetclutch shift`), the result checked by
+ * wc_shift_calibration_check. --lockstep: after every step's output frames a
+ * line "." and a flush, so that a plant simulator can drive the loop in
+ * closed loop through a pipe (tools/wetclutch/shift.py).
  *
  * Reads a candump -L log (the input frames), feeds each frame the TCU would
  * receive (wc_tcu's kernel filter: ClutchSensors, TorqueRequest, and
@@ -11,6 +20,7 @@
  * compares it with the double-precision reference of the loop, and with the
  * frames wc_tcu sends on vcan. Host program: stdio allowed. */
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,8 +56,48 @@ static int parse_line(const char *line, double *t_s, wc_can_frame_t *frame)
     return 0;
 }
 
+/* The float fields of wc_shift_calibration_t that --set may override. */
+typedef struct {
+    const char *name;
+    size_t offset;
+} shift_field_t;
+#define SHIFT_FIELD(f) { #f, offsetof(wc_shift_calibration_t, f) }
+static const shift_field_t shift_fields[] = {
+    SHIFT_FIELD(turbine_inertia_kg_m2), SHIFT_FIELD(turbine_ratio), SHIFT_FIELD(jerk_per_torque_rate),
+    SHIFT_FIELD(prepare_time_s), SHIFT_FIELD(torque_phase_time_s), SHIFT_FIELD(inertia_time_min_s),
+    SHIFT_FIELD(inertia_time_max_s), SHIFT_FIELD(inertia_timeout_factor), SHIFT_FIELD(lockup_ramp_time_s),
+    SHIFT_FIELD(holding_torque_factor), SHIFT_FIELD(min_start_slip_rad_s), SHIFT_FIELD(feedforward_gain),
+    SHIFT_FIELD(kp_Nm_per_rad_s), SHIFT_FIELD(ki_Nm_per_rad), SHIFT_FIELD(integral_limit_Nm),
+    SHIFT_FIELD(lag_compensation_time_s), SHIFT_FIELD(flare_slip_rad_s), SHIFT_FIELD(tie_up_factor),
+    SHIFT_FIELD(jerk_filter_time_s),
+};
+
+static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
+{
+    const char *eq = strchr(assignment, '=');
+    if (eq == NULL) { return -1; }
+    for (size_t i = 0; i < sizeof shift_fields / sizeof shift_fields[0]; ++i) {
+        if ((strlen(shift_fields[i].name) == (size_t)(eq - assignment)) &&
+            (strncmp(assignment, shift_fields[i].name, (size_t)(eq - assignment)) == 0)) {
+            char *end = NULL;
+            const double v = strtod(eq + 1, &end);
+            if ((end == eq + 1) || (*end != '\0')) { return -1; }
+            const float f = (float)v;
+            memcpy((char *)cal + shift_fields[i].offset, &f, sizeof f);
+            return 0;
+        }
+    }
+    return -1;
+}
+
+#define USAGE "usage: wc_replay LOG|- [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]" \
+              " [--shift NAME [--set FIELD=VALUE]...] [--lockstep]\n"
+
 int main(int argc, char **argv)
 {
+    static wc_shift_calibration_t shift;  /* the loop keeps a pointer to it */
+    const char *shift_name = NULL;
+    int lockstep = 0;
     const char *log_path = NULL;
     const char *calibration = "table1";
     int bench = 0;
@@ -55,18 +105,34 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; ++i) {
         char *end = NULL;
         if (strcmp(argv[i], "--bench") == 0) { bench = 1; }
+        else if (strcmp(argv[i], "--lockstep") == 0) { lockstep = 1; }
+        else if ((strcmp(argv[i], "--shift") == 0) && (i + 1 < argc) && (shift_name == NULL)) {
+            shift_name = argv[++i];
+            const wc_shift_calibration_t *found = wc_tcu_find_shift_calibration(shift_name);
+            if (found == NULL) {
+                fprintf(stderr, "wc_replay: --shift: '%s' is not compiled in\n", shift_name);
+                return 2;
+            }
+            shift = *found;
+        }
+        else if ((strcmp(argv[i], "--set") == 0) && (i + 1 < argc) && (shift_name != NULL)) {
+            if (set_shift_field(&shift, argv[++i]) != 0) {
+                fprintf(stderr, "wc_replay: --set: '%s' is not FIELD=NUMBER of a float shift calibration field\n", argv[i]);
+                return 2;
+            }
+        }
         else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; }
         else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
                  ((void)(theta_start_degC = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0')) &&
                  (theta_start_degC >= -40.0) && (theta_start_degC <= 250.0)) { ++i; }
-        else if ((argv[i][0] != '-') && (log_path == NULL)) { log_path = argv[i]; }
+        else if (((argv[i][0] != '-') || (strcmp(argv[i], "-") == 0)) && (log_path == NULL)) { log_path = argv[i]; }
         else {
-            fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]\n");
+            fprintf(stderr, USAGE);
             return 2;
         }
     }
     if (log_path == NULL) {
-        fprintf(stderr, "usage: wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]\n");
+        fprintf(stderr, USAGE);
         return 2;
     }
     const wc_calibration_t *cal = NULL;
@@ -80,17 +146,26 @@ int main(int argc, char **argv)
     static wc_loop_t loop;  /* large (receive ring): static storage */
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     config.bench_input_enabled = bench != 0;
+    if (shift_name != NULL) {
+        const wc_shift_cal_error_t shift_error = wc_shift_calibration_check(&shift);
+        if (shift_error != WC_SHIFT_CAL_OK) {
+            fprintf(stderr, "wc_replay: shift calibration %s rejected (wc_shift_cal_error_t %d)\n", shift_name,
+                    (int)shift_error);
+            return 2;
+        }
+        config.shift = &shift;
+    }
     if (wc_loop_init(&loop, cal, &config, (float)theta_start_degC) != WC_CAL_OK) {
         fprintf(stderr, "wc_replay: calibration %s rejected\n", calibration);
         return 2;
     }
-    FILE *in = fopen(log_path, "r");
+    FILE *in = (strcmp(log_path, "-") == 0) ? stdin : fopen(log_path, "r");
     if (in == NULL) {
         fprintf(stderr, "wc_replay: %s: %s\n", log_path, strerror(errno));
         return 2;
     }
-    const uint32_t ids[] = WC_LOOP_RX_IDS;
-    const size_t id_count = bench ? WC_LOOP_RX_ID_COUNT : WC_LOOP_RX_ID_COUNT - 1u;
+    uint32_t ids[WC_LOOP_RX_ID_COUNT];
+    const size_t id_count = wc_loop_rx_ids(&config, ids);  /* wc_tcu's kernel filter */
     char line[256];
     unsigned long line_no = 0;
     while (fgets(line, sizeof line, in) != NULL) {
@@ -115,8 +190,12 @@ int main(int argc, char **argv)
             for (uint8_t j = 0; j < out[k].dlc; ++j) { printf("%02X", out[k].data[j]); }
             printf("\n");
         }
+        if (lockstep && (n > 0u)) {
+            printf(".\n");
+            if (fflush(stdout) != 0) { return 1; }
+        }
     }
-    fclose(in);
+    if (in != stdin) { fclose(in); }
     if (fflush(stdout) != 0) {
         fprintf(stderr, "wc_replay: writing stdout failed\n");
         return 1;

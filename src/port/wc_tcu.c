@@ -41,6 +41,7 @@ typedef struct {
 typedef struct {
     const char *iface;
     const char *calibration;
+    const char *shift;        /* --shift NAME: shift control on (NULL: off) */
     const char *stats_json;
     int64_t period_ns;
     int frame_clock;
@@ -96,6 +97,8 @@ static void usage(FILE *out)
             "                            frame: one step per ClutchSensors frame (deterministic replay)\n"
             "  -p, --period-us N         step period for --clock timer (default: the calibration's, 1000)\n"
             "  -k, --calibration NAME    compiled-in calibration (default table1; --help lists them)\n"
+            "  -s, --shift NAME          shift control (TorqueRequest Mode 3, ShiftCommand) with this compiled-in\n"
+            "                            shift calibration (--help lists them); default off\n"
             "  -n, --steps N             stop after N steps (default: run until SIGINT/SIGTERM)\n"
             "  -I, --idle-exit S         stop once no frame has arrived for S seconds (timed from the first frame)\n"
             "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
@@ -130,12 +133,13 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"theta-start", required_argument, NULL, 't'}, {"stats-json", required_argument, NULL, 'j'},
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
         {"bench", no_argument, NULL, 'b'},            {"realtime", no_argument, NULL, 3},
+        {"shift", required_argument, NULL, 's'},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
     double v = 0.0;
     int c;
-    while ((c = getopt_long(argc, argv, "i:c:p:k:n:I:t:j:bh", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "i:c:p:k:s:n:I:t:j:bh", longopts, NULL)) != -1) {
         switch (c) {
         case 'i': o->iface = optarg; break;
         case 'c':
@@ -145,6 +149,7 @@ static int parse_options(int argc, char **argv, options_t *o)
             break;
         case 'p': if (parse_number(optarg, "--period-us", 50, 1e6, &v)) { return -1; } o->period_ns = (int64_t)(v * 1000.0); break;
         case 'k': o->calibration = optarg; break;
+        case 's': o->shift = optarg; break;
         case 'n': if (parse_number(optarg, "--steps", 1, 1e12, &v)) { return -1; } o->max_steps = (uint64_t)v; break;
         case 'I': if (parse_number(optarg, "--idle-exit", 0.001, 1e6, &v)) { return -1; } o->idle_exit_s = v; break;
         case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
@@ -157,6 +162,8 @@ static int parse_options(int argc, char **argv, options_t *o)
             usage(stdout);
             printf("calibrations:");
             for (size_t i = 0; i < wc_tcu_calibration_count; ++i) { printf(" %s", wc_tcu_calibrations[i].name); }
+            printf("\nshift calibrations:");
+            for (size_t i = 0; i < wc_tcu_shift_calibration_count; ++i) { printf(" %s", wc_tcu_shift_calibrations[i].name); }
             printf("\n");
             exit(0);
         default: usage(stderr); return -1;
@@ -365,6 +372,13 @@ int main(int argc, char **argv)
     config.sensor_timeout_periods = opt.sensor_timeout;
     config.request_timeout_periods = opt.request_timeout;
     config.bench_input_enabled = opt.bench != 0;
+    if (opt.shift != NULL) {
+        config.shift = wc_tcu_find_shift_calibration(opt.shift);
+        if (config.shift == NULL) {
+            fprintf(stderr, "wc_tcu: --shift: '%s' is not compiled in (wc_tcu --help lists them)\n", opt.shift);
+            return 2;
+        }
+    }
     const wc_cal_error_t cal_error = wc_loop_init(&loop, cal, &config, (float)opt.theta_start_degC);
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
@@ -391,14 +405,15 @@ int main(int argc, char **argv)
     }
 
     wc_socketcan_t port;
-    const uint32_t ids[] = WC_LOOP_RX_IDS;
-    /* BenchMeasurement is last in WC_LOOP_RX_IDS: filtered out unless --bench. */
-    if (wc_socketcan_open(&port, opt.iface, ids, opt.bench ? WC_LOOP_RX_ID_COUNT : WC_LOOP_RX_ID_COUNT - 1u) != 0) {
+    uint32_t ids[WC_LOOP_RX_ID_COUNT];
+    const uint32_t id_count = wc_loop_rx_ids(&config, ids);  /* ShiftCommand only with --shift, bench only with --bench */
+    if (wc_socketcan_open(&port, opt.iface, ids, id_count) != 0) {
         fprintf(stderr, "wc_tcu: %s\n", port.error);
         return 1;
     }
-    fprintf(stderr, "wc_tcu: %s, clock %s, period %lld us, calibration %s%s\n", opt.iface,
+    fprintf(stderr, "wc_tcu: %s, clock %s, period %lld us, calibration %s%s%s%s\n", opt.iface,
             opt.frame_clock ? "frame" : "timer", (long long)(opt.period_ns / 1000), opt.calibration,
+            (opt.shift != NULL) ? ", shift " : "", (opt.shift != NULL) ? opt.shift : "",
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
     port_stats_t ps = { 0u, 0u, 0u, 0 };

@@ -1,6 +1,9 @@
 #include "wc_tcu_calibrations.h"
 
+#include <string.h>
+
 #include "wc_bench_identified_calibration.h"
+#include "wc_shift_1_2_shift.h"
 #include "wc_table1_calibration.h"
 
 const wc_tcu_calibration_t wc_tcu_calibrations[] = {
@@ -9,3 +12,19 @@ const wc_tcu_calibration_t wc_tcu_calibrations[] = {
     {"bench_identified", &wc_bench_identified_calibration},
 };
 const size_t wc_tcu_calibration_count = sizeof wc_tcu_calibrations / sizeof wc_tcu_calibrations[0];
+
+const wc_tcu_shift_calibration_t wc_tcu_shift_calibrations[] = {
+    {"shift_1_2_full", &wc_shift_1_2_full},          /* (c) 2-DOF, full model */
+    {"shift_1_2_blind", &wc_shift_1_2_blind},        /* (b) 2-DOF, thermal-blind */
+    {"shift_1_2_feedback", &wc_shift_1_2_feedback},  /* (a) PI only */
+    {"shift_1_2_nolag", &wc_shift_1_2_nolag},        /* (c) without lag compensation */
+};
+const size_t wc_tcu_shift_calibration_count = sizeof wc_tcu_shift_calibrations / sizeof wc_tcu_shift_calibrations[0];
+
+const wc_shift_calibration_t *wc_tcu_find_shift_calibration(const char *name)
+{
+    for (size_t i = 0; i < wc_tcu_shift_calibration_count; ++i) {
+        if (strcmp(name, wc_tcu_shift_calibrations[i].name) == 0) { return wc_tcu_shift_calibrations[i].calibration; }
+    }
+    return NULL;
+}

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "wetclutch/wc_calibration.h"
+#include "wetclutch/wc_shift.h"
 
 typedef struct {
     const char *name;
@@ -15,5 +16,18 @@ typedef struct {
 
 extern const wc_tcu_calibration_t wc_tcu_calibrations[];
 extern const size_t wc_tcu_calibration_count;
+
+/* Shift calibrations (DESIGN 10), selected with --shift NAME: the variants of
+ * tools/calibrations/shift_1_2.toml (`wetclutch lut ... --out lut`). */
+typedef struct {
+    const char *name;
+    const wc_shift_calibration_t *calibration;
+} wc_tcu_shift_calibration_t;
+
+extern const wc_tcu_shift_calibration_t wc_tcu_shift_calibrations[];
+extern const size_t wc_tcu_shift_calibration_count;
+
+/* The named shift calibration, or NULL. */
+const wc_shift_calibration_t *wc_tcu_find_shift_calibration(const char *name);
 
 #endif /* WC_TCU_CALIBRATIONS_H */

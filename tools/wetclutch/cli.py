@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import atomic, calibration, lut, model, reference, vectors
+from . import atomic, calibration, lut, model, reference, shift_calibration, vectors
 from .csvio import CsvError, read_columns, write_columns
 from .errors import LogError
 
@@ -17,6 +17,11 @@ DEFAULT_CAL = "tools/calibrations/table1.toml"
 
 def _cmd_lut(args) -> int:
     lut.check_max_error(args.max_error)   # before any work: NaN or <= 0 would disable the check
+    if shift_calibration.is_shift_calibration(args.calibration):   # a [shift] table: the shift controller's
+        command = f"wetclutch lut {args.calibration} --out {args.out}"
+        written = shift_calibration.write_header(shift_calibration.load(args.calibration), Path(args.out), command)
+        print(f"wrote {written}")
+        return 0
     cal = calibration.load(args.calibration)
     name = args.name or Path(args.calibration).stem
     command = f"wetclutch lut {args.calibration} --out {args.out}" + (f" --name {args.name}" if args.name else "")
@@ -287,7 +292,8 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (calibration.CalibrationError, CsvError, lut.TableError, LogError, RuntimeError) as e:
+    except (calibration.CalibrationError, shift_calibration.ShiftCalibrationError, CsvError, lut.TableError, LogError,
+            RuntimeError) as e:
         if isinstance(e, (NotImplementedError, RecursionError)):
             raise                # RuntimeError's subclasses that are bugs, not input errors
         print(f"wetclutch {args.command}: {e}", file=sys.stderr)

@@ -1,0 +1,197 @@
+"""Shift calibration (TOML) of the on-coming clutch's shift controller (DESIGN 10).
+
+One file holds the base calibration in ``[shift]`` and named variants in
+``[variants.NAME]`` (each overrides some base values): the controllers the
+comparison of ``wetclutch shift`` runs on the same plant. Every value is
+``name = { value = ..., unit = "...", source = "..." }`` like the clutch
+calibration; the unit is checked. ``load`` applies the firmware's
+``wc_shift_calibration_check`` rules (include/wetclutch/wc_shift.h) to the
+float32 values, so a file the firmware would refuse is refused here.
+
+``write_header`` writes ``lut/wc_<stem>_shift.h`` (one const struct per
+variant) for the TCU program and the in-process simulator.
+"""
+from __future__ import annotations
+
+import math
+import struct
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from .atomic import Staged
+from .lut import c_float as _c_float, c_identifier
+
+
+class ShiftCalibrationError(Exception):
+    """A shift calibration that cannot be used; the message names file, variant and parameter."""
+
+
+TIME_MAX_S = 10.0
+INERTIA_TIME_MIN_S, INERTIA_TIME_MAX_S = 0.05, 5.0
+GAIN_MAX = 1e5
+TORQUE_MAX_NM = 5000.0     # WC_TORQUE_MAX_Nm
+SLIP_MAX_RAD_S = 1047.2    # WC_SLIP_MAX_rad_s
+
+# (name in the file, unit, C field, check) in the C struct's order. check(value, values) -> bool.
+FIELDS: tuple[tuple[str, str, str, object], ...] = (
+    ("turbine_inertia", "kg*m^2", "turbine_inertia_kg_m2", lambda v, c: 1e-4 <= v <= 100.0),
+    ("turbine_ratio", "1", "turbine_ratio", lambda v, c: 0.05 <= v <= 20.0),
+    ("jerk_per_torque_rate", "(m/s^3)/(Nm/s)", "jerk_per_torque_rate", lambda v, c: 0.0 <= v <= 1.0),
+    ("prepare_time", "s", "prepare_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("torque_phase_time", "s", "torque_phase_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("inertia_time_min", "s", "inertia_time_min_s", lambda v, c: INERTIA_TIME_MIN_S <= v <= INERTIA_TIME_MAX_S),
+    ("inertia_time_max", "s", "inertia_time_max_s",
+     lambda v, c: c["inertia_time_min"] <= v <= INERTIA_TIME_MAX_S),
+    ("inertia_timeout_factor", "1", "inertia_timeout_factor", lambda v, c: 1.05 <= v <= 10.0),
+    ("lockup_ramp_time", "s", "lockup_ramp_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("holding_torque_factor", "1", "holding_torque_factor", lambda v, c: 1.0 <= v <= 5.0),
+    ("min_start_slip", "rad/s", "min_start_slip_rad_s", lambda v, c: 0.0 <= v <= SLIP_MAX_RAD_S),
+    ("feedforward_gain", "1", "feedforward_gain", lambda v, c: 0.0 <= v <= 2.0),
+    ("kp", "Nm/(rad/s)", "kp_Nm_per_rad_s", lambda v, c: 0.0 <= v <= GAIN_MAX),
+    ("ki", "Nm/rad", "ki_Nm_per_rad", lambda v, c: 0.0 <= v <= GAIN_MAX),
+    ("integral_limit", "Nm", "integral_limit_Nm", lambda v, c: 0.0 <= v <= TORQUE_MAX_NM),
+    ("lag_compensation_time", "s", "lag_compensation_time_s", lambda v, c: v == 0.0 or 1e-3 <= v <= TIME_MAX_S),
+    ("theta_source", "1", "theta_source", lambda v, c: v in (0, 1)),
+    ("flare_slip", "rad/s", "flare_slip_rad_s", lambda v, c: 0.0 <= v <= SLIP_MAX_RAD_S),
+    ("tie_up_factor", "1", "tie_up_factor", lambda v, c: 1.0 <= v <= 10.0),
+    ("jerk_filter_time", "s", "jerk_filter_time_s", lambda v, c: v == 0.0 or 1e-3 <= v <= TIME_MAX_S),
+)
+INTEGER_FIELDS = ("theta_source",)
+THETA_SOURCES = {0: "observer", 1: "oil"}
+
+
+def _f32(x: float) -> float:
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+@dataclass(frozen=True)
+class ShiftCalibration:
+    name: str                 # variant name
+    values: dict              # file name -> value (float32-rounded; theta_source int)
+    sources: dict             # file name -> source text
+
+    def __getattr__(self, key):
+        try:
+            return self.__dict__["values"][key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+    def c_fields(self) -> list[tuple[str, float | int]]:
+        return [(c_field, self.values[name]) for name, _, c_field, _ in FIELDS]
+
+
+@dataclass(frozen=True)
+class ShiftCalibrationSet:
+    path: Path
+    variants: dict            # name -> ShiftCalibration, in file order
+
+
+def _entry(path, where, name, raw, unit):
+    if not isinstance(raw, dict) or "value" not in raw or "unit" not in raw:
+        raise ShiftCalibrationError(f"{path}: {where}.{name}: expected {{ value = ..., unit = \"{unit}\", source = ... }}")
+    if raw["unit"] != unit:
+        raise ShiftCalibrationError(f"{path}: {where}.{name}: unit '{raw['unit']}', expected '{unit}'")
+    value = raw["value"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ShiftCalibrationError(f"{path}: {where}.{name}: value {value!r} is not a number")
+    return value, str(raw.get("source", ""))
+
+
+def _check(path, variant, values):
+    for name, _, _, check in FIELDS:
+        v = values[name]
+        if name in INTEGER_FIELDS:
+            if v != int(v):
+                raise ShiftCalibrationError(f"{path}: variant '{variant}': {name} = {v!r}: a whole number required")
+        elif not math.isfinite(v):
+            raise ShiftCalibrationError(f"{path}: variant '{variant}': {name} = {v!r}: not finite")
+        if not check(v, values):
+            raise ShiftCalibrationError(f"{path}: variant '{variant}': {name} = {v!r} outside the firmware's limits"
+                                        " (wc_shift_calibration_check, include/wetclutch/wc_shift.h)")
+
+
+def load(path: str | Path) -> ShiftCalibrationSet:
+    path = Path(path)
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except OSError as e:
+        raise ShiftCalibrationError(f"{path}: cannot read: {e.strerror or e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ShiftCalibrationError(f"{path}: not valid TOML: {e}") from None
+    base = doc.get("shift")
+    if not isinstance(base, dict):
+        raise ShiftCalibrationError(f"{path}: no [shift] table")
+    unknown = set(doc) - {"shift", "variants"}
+    if unknown:
+        raise ShiftCalibrationError(f"{path}: unknown table(s) {sorted(unknown)}")
+    units = {name: unit for name, unit, _, _ in FIELDS}
+    values, sources = {}, {}
+    for name in base:
+        if name not in units:
+            raise ShiftCalibrationError(f"{path}: shift.{name}: unknown parameter")
+    for name, unit, _, _ in FIELDS:
+        if name not in base:
+            raise ShiftCalibrationError(f"{path}: shift.{name}: missing")
+        values[name], sources[name] = _entry(path, "shift", name, base[name], unit)
+    variants_doc = doc.get("variants", {"base": {}})
+    if not isinstance(variants_doc, dict) or not variants_doc:
+        raise ShiftCalibrationError(f"{path}: [variants] must hold at least one [variants.NAME] table")
+    variants = {}
+    for vname, overrides in variants_doc.items():
+        if not (vname.isidentifier() and vname.isascii()):
+            raise ShiftCalibrationError(f"{path}: variant name '{vname}' is not a C identifier")
+        if not isinstance(overrides, dict):
+            raise ShiftCalibrationError(f"{path}: variants.{vname} must be a table")
+        v, s = dict(values), dict(sources)
+        for name, raw in overrides.items():
+            if name == "description":
+                continue
+            if name not in units:
+                raise ShiftCalibrationError(f"{path}: variants.{vname}.{name}: unknown parameter")
+            v[name], s[name] = _entry(path, f"variants.{vname}", name, raw, units[name])
+        v = {k: (int(x) if k in INTEGER_FIELDS else _f32(float(x))) for k, x in v.items()}
+        _check(path, vname, v)
+        s["description"] = str(overrides.get("description", ""))
+        variants[vname] = ShiftCalibration(vname, v, s)
+    return ShiftCalibrationSet(path, variants)
+
+
+def header_text(cal_set: ShiftCalibrationSet, command: str) -> str:
+    stem = c_identifier(cal_set.path.stem)
+    guard = f"WC_LUT_{stem.upper()}_SHIFT_H"
+    units = {c_field: unit for _, unit, c_field, _ in FIELDS}
+    names = {c_field: name for name, _, c_field, _ in FIELDS}
+    lines = [f"/* generated by `{command}`, do not edit */",
+             f"/* Shift calibrations '{stem}' from {cal_set.path.name} (DESIGN 10). Include in one translation unit. */",
+             f"#ifndef {guard}", f"#define {guard}", "", "#include <wetclutch/wc_shift.h>", ""]
+    for vname, cal in cal_set.variants.items():
+        desc = cal.sources.get("description", "")
+        lines.append(f"/* {vname}: {desc} */" if desc else f"/* {vname} */")
+        lines.append(f"static const wc_shift_calibration_t wc_{stem}_{vname} = {{")
+        for c_field, value in cal.c_fields():
+            text = f"{int(value)}u" if names[c_field] in INTEGER_FIELDS else _c_float(value)
+            src = cal.sources[names[c_field]].replace("*/", "* /")
+            lines.append(f"    .{c_field} = {text}, /* {units[c_field]}; {src} */")
+        lines.append("};")
+        lines.append("")
+    lines.append(f"#endif /* {guard} */")
+    return "\n".join(lines) + "\n"
+
+
+def write_header(cal_set: ShiftCalibrationSet, out_dir: Path, command: str) -> Path:
+    out = Path(out_dir) / f"wc_{c_identifier(cal_set.path.stem)}_shift.h"
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    with Staged() as staged:
+        staged.write_text(out, header_text(cal_set, command))
+    return out
+
+
+def is_shift_calibration(path: str | Path) -> bool:
+    """A file with a [shift] table (the clutch calibrations have none)."""
+    try:
+        with open(path, "rb") as f:
+            return isinstance(tomllib.load(f).get("shift"), dict)
+    except (OSError, tomllib.TOMLDecodeError):
+        return False
