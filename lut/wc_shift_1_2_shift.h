@@ -10,7 +10,7 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
-    .prepare_time_s = 0.05f, /* s; fill to the kiss point before the torque phase */
+    .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
     .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
     .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
@@ -34,7 +34,7 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
-    .prepare_time_s = 0.05f, /* s; fill to the kiss point before the torque phase */
+    .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
     .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
     .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
@@ -58,7 +58,7 @@ static const wc_shift_calibration_t wc_shift_1_2_feedback = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
-    .prepare_time_s = 0.05f, /* s; fill to the kiss point before the torque phase */
+    .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
     .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
     .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
@@ -82,7 +82,7 @@ static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
-    .prepare_time_s = 0.05f, /* s; fill to the kiss point before the torque phase */
+    .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
     .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
     .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */

@@ -50,11 +50,18 @@ typedef struct {
      * the observer's estimate (a thermal-blind model, for comparisons); the
      * observer keeps running. */
     bool theta_from_oil;
+    /* The torque the clutch must carry once locked, for the lock-up decision
+     * and the locked estimate (DESIGN 9), when the caller knows it better than
+     * the request (a shift controller: the turbine torque's share while it
+     * commands more to lock). 0 (zero-initialized), not finite or out of
+     * range: the request. A bench's torque sensor takes precedence. */
+    float carried_torque_Nm;
 } wc_step_input_t;
 
 typedef struct {
     float current_mA;           /* VFS current command */
-    float pressure_command_Pa;  /* K * current: the pressure commanded */
+    float pressure_command_Pa;  /* the pressure wanted: K * current, or with the lag compensation the
+                                 * pressure the led current drives the VFS towards */
     float pressure_model_Pa;    /* pressure the lagged VFS is modelled to reach */
     float force_command_N;      /* contact force the inverse asked for */
     float theta_degC;           /* friction-surface temperature used this step */
@@ -102,7 +109,8 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *     state on, the asperity force at the squeeze film, which then advances
  *     under the apply force) -> torque model;
  *  4. lock-up (wc_lockup.h) with the torque the clutch must carry (on a
- *     bench: the measured torque; else the request in the lock direction)
+ *     bench: the measured torque; else carried_torque_Nm or the request, in
+ *     the lock direction)
  *     against the static capacity; while locked the estimate is the held
  *     torque (wc_lockup_torque_Nm) and WC_STATUS_LOCKED is set;
  *  5. observer advanced with P = |T dw| (0 while locked), T the model torque

@@ -16,9 +16,14 @@
  *   INERTIA   the reference slip goes from the slip at phase start to 0 in
  *             the commanded target time with zero slope at both ends
  *             (smoothstep); request = feed-forward + PI(slip - reference).
- *             Ends when the clutch model locks (wc_lockup, DESIGN 9).
+ *             Ends when the slip has stayed inside the clutch's lock band
+ *             (lock_slip_rad_s) for lock_dwell_periods, or the model locks.
  *   LOCKUP    hand-over: the request ramps to holding_torque_factor * T_t / a
- *             in lockup_ramp_time_s (the lock-up adds its holding margin).
+ *             in lockup_ramp_time_s, so that the static capacity exceeds the
+ *             torque the clutch carries (T_t / a, passed to the lock-up as
+ *             carried_torque_Nm) and the model locks (wc_lockup, DESIGN 9);
+ *             LOCKED once locked and the ramp done; not locked after twice
+ *             the ramp time: abort.
  *   LOCKED    shift complete; the holding request stays until the command ends.
  *   ABORTED   released to the safe state (minimum current) until the command
  *             ends; the report says why.
@@ -159,6 +164,7 @@ typedef struct {
     float filtered_torque_Nm;      /* jerk estimate filter state */
     float error_sq_sum;            /* sum of squared slip errors over the inertia phase, (rad/s)^2 */
     uint32_t inertia_periods;
+    uint32_t band_periods;         /* consecutive periods with the slip inside the lock band */
     wc_shift_report_t report;      /* running, final at the end */
 } wc_shift_t;
 

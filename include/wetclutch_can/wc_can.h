@@ -386,7 +386,7 @@ struct wc_can_vfs_command_t {
     uint16_t vfs_current;
 
     /**
-     * Piston pressure behind VfsCurrent (P = K i). 1/16 kPa/bit (binary) unsigned 16 bit: 0..4095.94 kPa, valid 0..4000 kPa (K = 2300 Pa/mA gives 2300 kPa at 1000 mA). The encoder maps NaN to 0 kPa and reports an error.
+     * Piston pressure the command aims at: P = K i of VfsCurrent, except with the hydraulic-lag compensation (Shift mode, DESIGN 9), where VfsCurrent leads the VFS lag and this is the wanted pressure the lag is driven towards. 1/16 kPa/bit (binary) unsigned 16 bit: 0..4095.94 kPa, valid 0..4000 kPa (K = 2300 Pa/mA gives 2300 kPa at 1000 mA). The encoder maps NaN to 0 kPa and reports an error.
      *
      * Range: 0..64000 (0..4000 kPa)
      * Scale: 0.0625

@@ -111,13 +111,13 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
+    out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if ((in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f)) {
         status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv);
     }
     out->current_mA = inv.current_mA;
     out->force_command_N = inv.force_N;
     out->inverse_iterations = inv.iterations;
-    out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;
 
     clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
@@ -153,7 +153,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
 
     /* DESIGN 9: lock-up against the static capacity at the contact force. */
     out->static_capacity_Nm = static_Nm_per_N * out->contact_force_N;
-    const float required_Nm = bench_torque ? in->bench.torque_Nm : direction * u->torque_request_Nm;
+    const bool carried = (in->carried_torque_Nm > 0.0f) && (in->carried_torque_Nm <= WC_TORQUE_MAX_Nm);
+    const float required_Nm = bench_torque ? in->bench.torque_Nm
+                                           : direction * (carried ? in->carried_torque_Nm : u->torque_request_Nm);
     const bool locked = wc_lockup_advance(&clutch->lockup, cal, u->slip_rad_s, required_Nm, out->static_capacity_Nm);
     if (locked) {
         out->model.torque_Nm = wc_lockup_held_Nm(&clutch->lockup, required_Nm, out->static_capacity_Nm);

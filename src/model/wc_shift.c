@@ -46,7 +46,7 @@ void wc_shift_init(wc_shift_t *shift)
 {
     WC_ASSERT(shift != NULL);
     if (shift == NULL) { return; }
-    static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u,
+    static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u, 0u,
                                      { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u } };
     *shift = idle;
 }
@@ -206,6 +206,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     wc_step_input_t in = *sensors;
     in.mode = WC_MODE_OPEN;
     in.torque_request_Nm = 0.0f;
+    in.carried_torque_Nm = 0.0f;
     in.lag_compensation_time_s = cal->lag_compensation_time_s;
     in.theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
     if (running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
@@ -215,6 +216,8 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             in.mode = WC_MODE_TORQUE;
             in.torque_request_Nm = request_Nm;
             shift->request_Nm = request_Nm;
+            /* once synchronous the clutch carries the turbine torque's share, not the request */
+            in.carried_torque_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;
         }
     }
     (void)wc_clutch_step(clutch, &in, out);
@@ -224,7 +227,11 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
-        if (locked) {
+        const wc_calibration_t *clutch_cal = clutch->model.cal;
+        const bool in_band = (clutch_cal != NULL) && (fabsf(slip_rad_s) < clutch_cal->lock_slip_rad_s);
+        shift->band_periods = in_band ? (shift->band_periods + 1u) : 0u;  /* bounded: the phase times out */
+        const bool synchronous = (clutch_cal != NULL) && (shift->band_periods >= clutch_cal->lock_dwell_periods);
+        if (locked || synchronous) {
             shift->report.inertia_time_s = elapsed_s;
             shift->phase_start_request_Nm = shift->request_Nm;
             enter(shift, WC_SHIFT_LOCKUP);
@@ -233,10 +240,10 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             abort_shift(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
         }
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
-        if (shift->phase_periods + 1u >= periods_of(cal->lockup_ramp_time_s, dt_s)) {
-            if (locked) { enter(shift, WC_SHIFT_LOCKED); }
-            else { abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED); }
-        }
+        /* locked once the ramp is done (the lock-up's dwell may end after it): within a second ramp time */
+        const uint32_t ramp = periods_of(cal->lockup_ramp_time_s, dt_s);
+        if (locked && (shift->phase_periods + 1u >= ramp)) { enter(shift, WC_SHIFT_LOCKED); }
+        else if (shift->phase_periods + 1u >= 2u * ramp + 1u) { abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED); }
     }
 
     /* Quality vector over the shift (command to its end). */

@@ -314,3 +314,12 @@ def test_variant_file_loads_like_the_default(tmp_path, params):
     path = _write_variant(tmp_path, lambda t: t)
     other = plant.load_plant(path)
     assert replace(other, path=params.path, calibration_path=params.calibration_path) == params
+
+
+def test_initial_speed_for_the_shift_command(params):
+    start = plant.initial_turbine_speed_rpm(params, oil_degC=80.0, turbine_torque_Nm=250.0)
+    assert start < params.turbine_speed - 300.0            # full load in 1st: about 2500 rpm/s
+    pl = plant.UpshiftPlant(params, oil_degC=80.0, turbine_torque_Nm=250.0, turbine_speed_rpm=start)
+    for _ in range(int(round(params.preroll_time / DT))):
+        pl.step(0.0, None)
+    assert pl.truth["turbine_speed_rpm"] == pytest.approx(params.turbine_speed, abs=0.1)

@@ -22,8 +22,9 @@ DBC_PATH = ROOT / "hil" / "wetclutch.dbc"
 
 SENSORS, REQUEST, COMMAND, ESTIMATE, BENCH = (
     "ClutchSensors", "TorqueRequest", "VfsCommand", "ClutchEstimate", "BenchMeasurement")
-E2E_FRAMES = (SENSORS, REQUEST, COMMAND)
-MODE_OPEN, MODE_TORQUE_CONTROL, MODE_LOCKED = 0, 1, 2
+SHIFT_COMMAND, SHIFT_REPORT = "ShiftCommand", "ShiftReport"
+E2E_FRAMES = (SENSORS, REQUEST, SHIFT_COMMAND, COMMAND)
+MODE_OPEN, MODE_TORQUE_CONTROL, MODE_LOCKED, MODE_SHIFT = 0, 1, 2, 3
 
 
 

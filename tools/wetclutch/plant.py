@@ -642,3 +642,22 @@ class UpshiftPlant:
         """Every truth channel per period, the initial state first: {name: numpy array}."""
         arr = np.array(self._rows, dtype=float)
         return {c: arr[:, k].copy() for k, c in enumerate(TRUTH_NAMES)}
+
+
+def initial_turbine_speed_rpm(params: PlantParams, *, oil_degC: float, turbine_torque_Nm: float,
+                              speed_at_command_rpm: float | None = None, preroll_s: float | None = None,
+                              **kwargs) -> float:
+    """The turbine speed to start the plant at so that, after preroll_s of steady 1st gear (current 0),
+    the turbine is at speed_at_command_rpm when the shift is commanded (defaults: the [scenario]
+    turbine_speed and preroll_time). The 1st-gear acceleration is nearly constant: two corrections
+    (the second only for the drag's and road load's drift) leave well under 0.1 rpm."""
+    target = params.turbine_speed if speed_at_command_rpm is None else float(speed_at_command_rpm)
+    n = int(round((params.preroll_time if preroll_s is None else float(preroll_s)) / DT_S))
+    start = target
+    for _ in range(2):
+        pl = UpshiftPlant(params, oil_degC=oil_degC, turbine_torque_Nm=turbine_torque_Nm,
+                          turbine_speed_rpm=start, **kwargs)
+        for _ in range(n):
+            pl.step(0.0, None)
+        start -= pl.truth["turbine_speed_rpm"] - target
+    return start

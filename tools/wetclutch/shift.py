@@ -1,0 +1,293 @@
+"""Closed-loop 1->2 upshifts: the plant simulator (plant.py) against the TCU's frame loop (``wetclutch shift``).
+
+Lockstep on the frame clock: each period the plant's VCU/sensor side sends
+TorqueRequest (Mode 3, Shift), ShiftCommand and ClutchSensors (last: it steps
+the loop), the TCU answers VfsCommand, ClutchEstimate and, in the step a shift
+ends, ShiftReport; the plant then advances one period with that VFS current.
+Two TCUs run the same firmware code:
+
+  InprocTcu  `wc_replay --lockstep --shift NAME` through a pipe (the frame loop
+             linked into a host program): fast, for the scenario matrix;
+  VcanTcu    `wc_tcu --clock frame --shift NAME` on a SocketCAN interface
+             (python-can), natively or in the QEMU guest (hil/shift_guest.sh).
+
+For the same case both give the same output frames (tests/python/test_shift.py).
+
+Controllers compared (issue 13), variants of tools/calibrations/shift_1_2.toml:
+(a) feedback: PI only; (b) blind: 2-DOF, clutch temperature = oil; (c) full:
+2-DOF with observer, film state, lock-up and lag compensation; plus nolag ((c)
+without the lag compensation) for the pressure-tracking figure.
+
+Quality per shift, from the plant's truth (DESIGN 10):
+  inertia_time_s   from the controller's inertia-phase start (the command +
+                   prepare + torque-phase time) to the on-coming clutch's lock;
+  slip_rmse_rpm    RMS(true slip - reference slip) over the inertia phase
+                   (the reference is the controller's: a smoothstep from the
+                   measured slip at the phase start to 0 in the target time);
+  peak_jerk_m_s3   max |d/dt of the vehicle acceleration| from the command to
+                   the end, the acceleration low-passed at 10 Hz (2nd-order
+                   Butterworth, zero phase): the band ride-comfort ratings
+                   weight (ISO 2631-1 up to about 8 Hz), above it driveline
+                   ringing the occupants do not feel as jerk;
+  friction_energy_kJ, peak_theta_degC (true pack temperature);
+  flare            turbine speed above the 1st-gear synchronous speed by more
+                   than FLARE_RPM (the engine runs up: too little clutch torque);
+  tie_up           the off-going clutch carrying torque against its release
+                   direction (negative, fighting the shift) above TIE_UP_FRACTION
+                   of the turbine torque;
+  abort            the TCU's ShiftReport AbortReason (or no report at all);
+  pressure_rmse_kPa RMS(true piston pressure - the TCU's PressureCommand, the
+                   pressure it wants) from the command to the end.
+"""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from . import canlog, plant as plant_mod, shift_calibration
+from .atomic import Staged
+
+ROOT = Path(__file__).resolve().parents[2]
+WC_REPLAY = ROOT / "build" / "host-release" / "src" / "host" / "wc_replay"
+SHIFT_TOML = ROOT / "tools" / "calibrations" / "shift_1_2.toml"
+TCU_CALIBRATION = "bench_identified"     # the TCU's clutch model: identified from the bench (truth: bench_true)
+CONTROLLERS = {"a": "feedback", "b": "blind", "c": "full"}
+TARGET_INERTIA_S = 0.5
+FLARE_RPM = 20.0
+TIE_UP_FRACTION = 0.1
+JERK_CUTOFF_HZ = 10.0
+SOAK_SHIFTS = 10
+ABORT_NAMES = {0: "completed", 1: "inertia timeout", 2: "lockup failed", 3: "input lost", 4: "cancelled",
+               5: "invalid command", 6: "no slip", -1: "no report"}
+
+
+class ShiftError(RuntimeError):
+    pass
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    oil_degC: float
+    load: float                  # turbine torque / full load
+    friction_scale: float = 1.0
+    shifts: int = 1              # > 1: back-to-back shifts, temperatures carried over (heat soak)
+    group: str = ""
+
+
+def scenario_matrix(nominal_oil_degC: float = 80.0) -> list[Scenario]:
+    """Issue 13's matrix: oil 20..110 degC at full load, load 25/50/100 % at the nominal oil, plant friction
+    -/+10 % (model error), a heat soak of SOAK_SHIFTS full-load shifts. Nominal: 80 degC, 100 %, friction 1."""
+    out = [Scenario(f"oil{int(t)}", t, 1.0, group="oil") for t in (20.0, 40.0, 60.0, 80.0, 100.0, 110.0)]
+    out += [Scenario(f"load{int(x * 100)}", nominal_oil_degC, x, group="load") for x in (0.25, 0.5)]
+    out += [Scenario(f"friction{s:+.0%}".replace("%", "pct"), nominal_oil_degC, 1.0, s, group="friction")
+            for s in (0.9, 1.1)]
+    out.append(Scenario("soak", nominal_oil_degC, 1.0, shifts=SOAK_SHIFTS, group="soak"))
+    return out
+
+
+NOMINAL = "oil80"
+
+
+class InprocTcu:
+    """The frame loop in-process: wc_replay --lockstep through a pipe."""
+
+    def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
+                 calibration: str = TCU_CALIBRATION, program: Path = WC_REPLAY):
+        if not Path(program).is_file():
+            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
+        cmd = [str(program), "-", "--lockstep", "--calibration", calibration, "--theta-start",
+               f"{theta_start_degC:.6g}", "--shift", shift_name]
+        for k, v in (overrides or {}).items():
+            cmd += ["--set", f"{k}={v:.9g}"]
+        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, bufsize=1)
+
+    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
+        lines = "".join(f"({t_s:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n" for m in frames)
+        try:
+            self.proc.stdin.write(lines)
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}") from None
+        out = []
+        while True:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}")
+            line = line.strip()
+            if line == ".":
+                return out
+            ident, data = line.split()[2].split("#")
+            out.append((int(ident, 16), bytes.fromhex(data)))
+
+    def close(self):
+        if self.proc.stdin:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=10)
+        self.proc.stdout.close()
+        self.proc.stderr.close()
+
+
+def reference_slip(start_rad_s: float, target_s: float, elapsed_s: np.ndarray) -> np.ndarray:
+    """The controller's reference (wc_shift_reference_slip): start (1 - (3x^2 - 2x^3)), x = elapsed / target."""
+    x = np.clip(elapsed_s / target_s, 0.0, 1.0)
+    return start_rad_s * (1.0 - x * x * (3.0 - 2.0 * x))
+
+
+def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s: float, seed: int,
+               target_s: float, shift_cal) -> dict:
+    """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record."""
+    p = params
+    full = p.turbine_torque_full * scenario.load
+    pl = plant_mod.UpshiftPlant(p, oil_degC=scenario.oil_degC, turbine_torque_Nm=full,
+                                friction_scale=p.friction_scale * scenario.friction_scale, seed=seed,
+                                theta_clutch_degC=theta_clutch_degC)
+    dt = pl.dt_s
+    n_pre = int(round(p.preroll_time / dt))
+    n = n_pre + int(round(p.shift_duration / dt))
+    msg_cmd = db.get_message_by_name(canlog.COMMAND)
+    msg_est = db.get_message_by_name(canlog.ESTIMATE)
+    msg_rep = db.get_message_by_name(canlog.SHIFT_REPORT)
+    rec = {k: np.empty(n) for k in ("t_s", "sensor_slip_rad_s", "current_mA", "pressure_command_Pa",
+                                    "theta_estimate_degC", "model_torque_Nm", "locked_tcu")}
+    truth = {}
+    frames_out = []
+    report = None
+    current = 0.0
+    for k in range(n):
+        t = t0_s + k * dt
+        s = pl.sensors()
+        frames = [enc.frame(canlog.REQUEST, TorqueRequest=0.0, Mode=canlog.MODE_SHIFT),
+                  enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=int(k >= n_pre), TargetGear=2,
+                            TurbineTorque=float(np.clip(s["turbine_torque_estimate_Nm"], -1000.0, 1000.0)),
+                            TargetInertiaTime=round(target_s * 1e3)),
+                  enc.frame(canlog.SENSORS, SlipSpeed=float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
+                            OilTemp=float(s["oil_degC"]), HousingTemp=float(s["housing_degC"]))]
+        out = tcu.exchange(t, frames)
+        for fid, data in out:
+            frames_out.append((k, fid, data.hex().upper()))
+            if fid == msg_cmd.frame_id:
+                c = msg_cmd.decode(data)
+                current = float(c["VfsCurrent"])
+                rec["current_mA"][k] = current
+                rec["pressure_command_Pa"][k] = float(c["PressureCommand"]) * 1e3
+                rec["locked_tcu"][k] = float(c["StatusLocked"])
+            elif fid == msg_est.frame_id:
+                e = msg_est.decode(data, decode_choices=False)
+                rec["theta_estimate_degC"][k] = float(e["EstimatedClutchTemp"])
+                rec["model_torque_Nm"][k] = float(e["ModelTorque"])
+            elif fid == msg_rep.frame_id:
+                report = msg_rep.decode(data, decode_choices=False)
+                report["step"] = k
+        rec["t_s"][k] = k * dt
+        rec["sensor_slip_rad_s"][k] = s["slip_rpm"] * plant_mod.RPM
+        pl.step(current, (k - n_pre) * dt if k >= n_pre else None)
+        for name, v in pl.truth.items():
+            truth.setdefault(name, np.empty(n))[k] = v
+    rec.update({f"true_{k}": v for k, v in truth.items()})
+    rec["frames"] = frames_out
+    rec["report"] = report
+    rec["command_step"] = n_pre
+    n_prep = int(shift_cal.prepare_time / dt + 0.5)
+    n_tp = int(shift_cal.torque_phase_time / dt + 0.5)
+    k_i = n_pre + n_prep + n_tp           # the controller enters the inertia phase at this step (wc_shift.c)
+    rec["inertia_step"] = k_i
+    start = rec["sensor_slip_rad_s"][k_i]
+    ref = np.full(n, np.nan)
+    ref[k_i:] = reference_slip(start, target_s, (np.arange(n - k_i)) * dt)
+    rec["reference_slip_rad_s"] = ref
+    rec["end_theta_degC"] = float(truth["theta_clutch_degC"][-1])
+    return rec
+
+
+def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None = None, tcu=None,
+             target_s: float = TARGET_INERTIA_S, shift_cal=None) -> list[dict]:
+    """All shifts of a scenario (one, or the soak's back-to-back shifts with one TCU and the clutch
+    temperature carried over); returns one record per shift."""
+    shift_cal = shift_cal or shift_calibration.load(SHIFT_TOML).variants[shift_name.split("shift_1_2_")[-1]]
+    own = tcu is None
+    tcu = tcu or InprocTcu(shift_name, scenario.oil_degC, overrides)
+    try:
+        enc = canlog.Encoder()
+        db = enc.db
+        theta = None
+        t0 = 0.0
+        records = []
+        for i in range(scenario.shifts):
+            rec = _one_shift(params, tcu, enc, db, scenario, theta, t0, params.seed + i, target_s, shift_cal)
+            records.append(rec)
+            theta = rec["end_theta_degC"]
+            t0 += rec["t_s"][-1] + 1e-3
+        return records
+    finally:
+        if own:
+            tcu.close()
+
+
+def _lowpass_zero_phase(x: np.ndarray, dt: float, cutoff_hz: float) -> np.ndarray:
+    from scipy.signal import butter, filtfilt
+    b, a = butter(2, cutoff_hz * 2.0 * dt)
+    return filtfilt(b, a, x)
+
+
+def quality(rec: dict, target_s: float = TARGET_INERTIA_S) -> dict:
+    """The quality vector of one shift from the plant's truth (module docstring)."""
+    dt = rec["t_s"][1] - rec["t_s"][0]
+    k0, ki = rec["command_step"], rec["inertia_step"]
+    locked = rec["true_oncoming_locked"] > 0.5
+    lock_idx = np.flatnonzero(locked[ki:])
+    k_lock = ki + int(lock_idx[0]) if lock_idx.size else None
+    inertia = (k_lock - ki) * dt if k_lock is not None else float("nan")
+    k_end = k_lock if k_lock is not None else len(locked)
+    err = rec["true_slip_rad_s"][ki:k_end] - rec["reference_slip_rad_s"][ki:k_end]
+    accel = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
+    jerk = np.gradient(accel, dt)
+    flare_rpm = float(np.max(rec["true_turbine_speed_rpm"][k0:] - rec["true_gear1_speed_rpm"][k0:]))
+    t_t = max(abs(float(np.mean(rec["true_turbine_torque_Nm"]))), 1.0)
+    fight = float(np.max(np.maximum(-rec["true_offgoing_torque_Nm"][k0:], 0.0)))
+    report = rec["report"]
+    abort = int(report["AbortReason"]) if report is not None else -1
+    p_err = rec["true_pressure_Pa"][k0:] - rec["pressure_command_Pa"][k0:]
+    return {
+        "inertia_time_s": inertia,
+        "inertia_time_error": (inertia - target_s) / target_s if math.isfinite(inertia) else float("nan"),
+        "slip_rmse_rpm": float(np.sqrt(np.mean(err ** 2)) / plant_mod.RPM) if err.size else float("nan"),
+        "peak_jerk_m_s3": float(np.max(np.abs(jerk[k0:]))),
+        "friction_energy_kJ": float(np.sum(rec["true_friction_power_W"][k0:]) * dt * 1e-3),
+        "peak_theta_degC": float(np.max(rec["true_theta_clutch_degC"][k0:])),
+        "peak_theta_estimate_degC": float(np.max(rec["theta_estimate_degC"][k0:])),
+        "flare": bool(flare_rpm > FLARE_RPM),
+        "flare_rpm": flare_rpm,
+        "tie_up": bool(fight > TIE_UP_FRACTION * t_t),
+        "tie_up_Nm": fight,
+        "abort": abort,
+        "abort_reason": ABORT_NAMES.get(abort, str(abort)),
+        "pressure_rmse_kPa": float(np.sqrt(np.mean(p_err ** 2)) * 1e-3),
+        "tcu_report": {k: (float(v) if k != "step" else int(v)) for k, v in report.items()} if report else None,
+    }
+
+
+def worst(qs: list[dict]) -> dict:
+    """A scenario's figures over its shifts (the soak): the worst of each."""
+    if len(qs) == 1:
+        return dict(qs[0])
+    out = dict(qs[-1])
+    for key in ("slip_rmse_rpm", "peak_jerk_m_s3", "peak_theta_degC", "friction_energy_kJ", "pressure_rmse_kPa",
+                "flare_rpm", "tie_up_Nm"):
+        out[key] = max(q[key] for q in qs)
+    out["inertia_time_error"] = max((q["inertia_time_error"] for q in qs), key=lambda e: abs(e) if math.isfinite(e) else 1e9)
+    out["inertia_time_s"] = max((q["inertia_time_s"] for q in qs),
+                                key=lambda t: abs(t - TARGET_INERTIA_S) if math.isfinite(t) else 1e9)
+    out["flare"] = any(q["flare"] for q in qs)
+    out["tie_up"] = any(q["tie_up"] for q in qs)
+    aborts = [q["abort"] for q in qs if q["abort"] != 0]
+    out["abort"] = aborts[0] if aborts else 0
+    out["abort_reason"] = ABORT_NAMES.get(out["abort"], str(out["abort"]))
+    out["shifts"] = len(qs)
+    return out
