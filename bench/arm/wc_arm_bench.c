@@ -28,6 +28,20 @@
  * agree with wc_inverse within NAIVE_AGREEMENT_mN; the ratio naive /
  * wc_inverse of the solve rows' median and worst is printed.
  *
+ * Shift control (DESIGN 10) is measured over a realistic trajectory instead
+ * of the grid: one 1->2 upshift (turbine torque 100 Nm, slip 100 rad/s at the
+ * inertia phase's start, target 0.5 s, oil 80 degC) on the reduced plant of
+ * tests/c/test_shift.c (I_t d(slip)/dt = a (T_t - a T_c), the turbine held
+ * until the inertia phase, the output side fixed), with the shift
+ * calibration of that test (lag compensation 15 ms, observer temperature).
+ * Every step that starts in the inertia phase is a sample:
+ *   wc_shift_step:inertia       wc_shift_step (clutch step with the lag
+ *                               compensation included);
+ *   wc_loop_step:shift_inertia  wc_loop_step in Shift mode (TorqueRequest
+ *                               Mode 3), three frames (ClutchSensors,
+ *                               TorqueRequest, ShiftCommand) queued per period.
+ * The shift must complete (LOCKED, one report, no safe step) or RESULT FAIL.
+ *
  * Output lines (parsed by scripts/bench_arm.sh):
  *   EMPTY <instructions>        window overhead, subtracted from every figure
  *   NOP <instructions>          1000 nops (must read 1000)
@@ -105,6 +119,8 @@ typedef enum {
     ROW_ENCODE_VFS_COMMAND,
     ROW_ENCODE_CLUTCH_ESTIMATE,
     ROW_CRC8,
+    ROW_SHIFT_STEP,
+    ROW_LOOP_STEP_SHIFT,
     ROWS
 } row_t;
 
@@ -128,9 +144,14 @@ static const char *const row_name[ROWS] = {
     [ROW_ENCODE_VFS_COMMAND] = "wc_can_encode_vfs_command",
     [ROW_ENCODE_CLUTCH_ESTIMATE] = "wc_can_encode_clutch_estimate",
     [ROW_CRC8] = "wc_e2e_crc8_j1850:8B",
+    [ROW_SHIFT_STEP] = "wc_shift_step:inertia",
+    [ROW_LOOP_STEP_SHIFT] = "wc_loop_step:shift_inertia",
 };
 
-#define SAMPLES_PER_ROW (2u * GRID_POINTS)  /* expf: two arguments per point */
+/* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods. */
+#define SHIFT_SAMPLES_MAX 768u
+/* expf: two arguments per grid point; the shift rows: one per inertia-phase period */
+#define SAMPLES_PER_ROW ((2u * GRID_POINTS > SHIFT_SAMPLES_MAX) ? 2u * GRID_POINTS : SHIFT_SAMPLES_MAX)
 static uint32_t samples[ROWS][SAMPLES_PER_ROW];
 static uint32_t sample_count[ROWS];
 
@@ -167,6 +188,11 @@ typedef struct {
     wc_can_clutch_estimate_phys_t estimate;
     wc_can_result_t can_result;
     uint8_t crc;
+    wc_shift_t *shift;
+    const wc_shift_calibration_t *shift_cal;
+    wc_shift_command_t shift_command;
+    wc_shift_report_t shift_report;
+    bool shift_ended;
 } bench_ctx_t;
 
 typedef void (*thunk_t)(void *ctx);
@@ -222,6 +248,12 @@ THUNK(thunk_loop_step)
 {
     bench_ctx_t *c = ctx;
     c->tx_frames = wc_loop_step(c->loop, c->tx);
+}
+THUNK(thunk_shift_step)
+{
+    bench_ctx_t *c = ctx;
+    c->shift_ended = wc_shift_step(c->shift, c->shift_cal, &c->shift_command, false, c->clutch, &c->step_in,
+                                   &c->step_out, &c->shift_report);
 }
 THUNK(thunk_decode_clutch_sensors)
 {
@@ -425,7 +457,9 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
     /* wc_clutch_step: a fresh clutch at theta, the 4th step measured. */
     if (wc_clutch_init(&clutch, model.cal, theta_degC) != WC_CAL_OK) { fail("wc_clutch_init"); }
     ctx.clutch = &clutch;
-    ctx.step_in = (wc_step_input_t){slip_rad_s, theta_degC, theta_degC, request_Nm, WC_MODE_TORQUE, {false, 0.0f, 0.0f}};
+    ctx.step_in = (wc_step_input_t){.slip_rad_s = slip_rad_s, .theta_oil_degC = theta_degC,
+                                    .theta_housing_degC = theta_degC, .torque_request_Nm = request_Nm,
+                                    .mode = WC_MODE_TORQUE, .bench = {false, 0.0f, 0.0f}};
     for (uint32_t k = 0u; k < WARMUP_STEPS; ++k) { thunk_clutch_step(&ctx); }
     record(ROW_CLUTCH_STEP, measure(thunk_clutch_step, &ctx));
     if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step rejected a grid point"); }
@@ -453,7 +487,7 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
         }
     }
     const uint32_t frames_in = 2u * (WARMUP_STEPS + 1u);
-    if ((ctx.tx_frames != WC_LOOP_TX_FRAMES) || (loop.counters.frames_used != frames_in) ||
+    if ((ctx.tx_frames != WC_LOOP_TX_CYCLIC) || (loop.counters.frames_used != frames_in) ||
         (loop.counters.safe_steps != 0u)) {
         wc_arm_puts("LOOP frames used ");
         wc_arm_put_u32(loop.counters.frames_used);
@@ -475,6 +509,180 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
                                                    1.0e6f * step.model.hbar_m, 0u};
     record(ROW_ENCODE_CLUTCH_ESTIMATE, measure(thunk_encode_clutch_estimate, &ctx));
     record(ROW_CRC8, measure(thunk_crc8, &ctx));
+}
+
+/* ------------------------------------------------------------------------ */
+/* Shift control over one upshift (DESIGN 10)                               */
+
+#define SHIFT_TURBINE_TORQUE_Nm 100.0f
+#define SHIFT_START_SLIP_rad_s 100.0f
+#define SHIFT_TARGET_TIME_s 0.5f
+#define SHIFT_OIL_degC 80.0f
+#define SHIFT_MAX_PERIODS 3000u
+
+/* tests/c/test_shift.c's calibration. */
+static const wc_shift_calibration_t shift_calibration = {
+    .turbine_inertia_kg_m2 = 0.25f,
+    .turbine_ratio = 1.0f,
+    .jerk_per_torque_rate = 0.01f,
+    .prepare_time_s = 0.05f,
+    .torque_phase_time_s = 0.1f,
+    .inertia_time_min_s = 0.1f,
+    .inertia_time_max_s = 2.0f,
+    .inertia_timeout_factor = 1.5f,
+    .lockup_ramp_time_s = 0.05f,
+    .holding_torque_factor = 1.3f,
+    .min_start_slip_rad_s = 5.0f,
+    .feedforward_gain = 1.0f,
+    .kp_Nm_per_rad_s = 2.0f,
+    .ki_Nm_per_rad = 40.0f,
+    .integral_limit_Nm = 300.0f,
+    .lag_compensation_time_s = 0.015f,
+    .theta_source = (uint32_t)WC_SHIFT_THETA_OBSERVER,
+    .flare_slip_rad_s = 10.0f,
+    .tie_up_factor = 1.5f,
+    .jerk_filter_time_s = 0.02f,
+};
+
+/* The plant of tests/c/test_shift.c: the turbine held by the off-going clutch
+ * until the inertia phase, then I_t d(slip)/dt = a (T_t - a T_c); the plates
+ * stick at zero slip and while the model is locked. */
+typedef struct {
+    float slip_rad_s;
+    bool released;
+} shift_plant_t;
+
+static void plant_advance(shift_plant_t *p, uint32_t phase, const wc_step_output_t *out)
+{
+    if (phase == (uint32_t)WC_SHIFT_INERTIA) { p->released = true; }
+    if (!p->released) { return; }
+    const float a = shift_calibration.turbine_ratio;
+    const float accel = a * (SHIFT_TURBINE_TORQUE_Nm - a * out->model.torque_Nm) / shift_calibration.turbine_inertia_kg_m2;
+    float next = p->slip_rad_s + accel * wc_arm_calibration->control_period_s;
+    if ((p->slip_rad_s >= 0.0f) && (next < 0.0f)) { next = 0.0f; }
+    if ((out->status & WC_STATUS_LOCKED) != 0u) { next = 0.0f; }
+    p->slip_rad_s = fminf(next, 1000.0f);
+}
+
+static wc_shift_t shift;
+
+/* wc_shift_step on its own: every step that starts in the inertia phase. */
+static void bench_shift_step(void)
+{
+    if ((wc_shift_calibration_check(&shift_calibration) != WC_SHIFT_CAL_OK) ||
+        (wc_clutch_init(&clutch, wc_arm_calibration, SHIFT_OIL_degC) != WC_CAL_OK)) {
+        fail("shift: calibration");
+        return;
+    }
+    wc_shift_init(&shift);
+    shift_plant_t plant = {SHIFT_START_SLIP_rad_s, false};
+    ctx.clutch = &clutch;
+    ctx.shift = &shift;
+    ctx.shift_cal = &shift_calibration;
+    ctx.shift_command = (wc_shift_command_t){true, 2u, SHIFT_TURBINE_TORQUE_Nm, SHIFT_TARGET_TIME_s};
+    static const wc_step_output_t no_output;
+    ctx.step_out = no_output;  /* wc_shift_step reads the previous step's status (anti-windup) */
+    uint32_t reports = 0u;
+    for (uint32_t k = 0u; (k < SHIFT_MAX_PERIODS) && (reports == 0u); ++k) {
+        ctx.step_in = (wc_step_input_t){.slip_rad_s = plant.slip_rad_s, .theta_oil_degC = SHIFT_OIL_degC,
+                                        .theta_housing_degC = SHIFT_OIL_degC};
+        if (shift.phase == (uint32_t)WC_SHIFT_INERTIA) {
+            record(ROW_SHIFT_STEP, measure(thunk_shift_step, &ctx));
+        } else {
+            thunk_shift_step(&ctx);
+        }
+        if (ctx.shift_ended) { reports++; }
+        plant_advance(&plant, shift.phase, &ctx.step_out);
+    }
+    if ((reports != 1u) || (shift.phase != (uint32_t)WC_SHIFT_LOCKED) || (ctx.shift_report.abort_reason != 0u)) {
+        wc_arm_puts("SHIFT phase ");
+        wc_arm_put_u32(shift.phase);
+        wc_arm_puts(", abort reason ");
+        wc_arm_put_u32(ctx.shift_report.abort_reason);
+        wc_arm_puts("\n");
+        fail("wc_shift_step: the shift did not complete");
+    }
+    wc_arm_puts("SHIFT wc_shift_step: inertia phase ");
+    wc_arm_put_u32((uint32_t)lroundf(ctx.shift_report.inertia_time_s * 1000.0f));
+    wc_arm_puts(" ms (target ");
+    wc_arm_put_u32((uint32_t)lroundf(SHIFT_TARGET_TIME_s * 1000.0f));
+    wc_arm_puts(" ms), slip RMSE ");
+    wc_arm_put_fixed((uint32_t)lroundf(ctx.shift_report.slip_rmse_rad_s * 1000.0f), 3u);
+    wc_arm_puts(" rad/s\n");
+}
+
+/* ClutchSensors, TorqueRequest (Mode 3 Shift) and ShiftCommand of one period. */
+static void queue_shift_frames(float slip_rad_s, bool shift_request, uint8_t alive)
+{
+    const wc_can_clutch_sensors_phys_t sensors = {slip_rad_s / WC_RAD_S_PER_RPM, SHIFT_OIL_degC, SHIFT_OIL_degC, alive};
+    const wc_can_torque_request_phys_t request = {0.0f, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, alive};
+    const wc_can_shift_command_phys_t command = {shift_request ? 1.0f : 0.0f, 2.0f, SHIFT_TURBINE_TORQUE_Nm, SHIFT_TARGET_TIME_s * 1000.0f, alive};
+    wc_can_frame_t frame = {WC_CAN_CLUTCH_SENSORS_FRAME_ID, 8u, 0u, {0u}};
+    if (wc_can_encode_clutch_sensors(frame.data, &sensors, sizeof frame.data) != WC_CAN_OK) { fail("shift: sensors frame"); }
+    (void)wc_loop_receive(&loop, &frame);
+    frame.id = WC_CAN_TORQUE_REQUEST_FRAME_ID;
+    if (wc_can_encode_torque_request(frame.data, &request, sizeof frame.data) != WC_CAN_OK) { fail("shift: request frame"); }
+    (void)wc_loop_receive(&loop, &frame);
+    frame.id = WC_CAN_SHIFT_COMMAND_FRAME_ID;
+    if (wc_can_encode_shift_command(frame.data, &command, sizeof frame.data) != WC_CAN_OK) { fail("shift: command frame"); }
+    (void)wc_loop_receive(&loop, &frame);
+}
+
+/* wc_loop_step in Shift mode: the default configuration with the shift
+ * calibration. ShiftRequest is 0 until the loop has left its safe state (E2E
+ * sync, recovery_periods), then 1: a rising edge outside the safe state
+ * starts the shift. Every step that starts in the inertia phase is a sample. */
+#define SHIFT_LOOP_SETTLE_PERIODS 40u
+static void bench_loop_shift(void)
+{
+    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    config.shift = &shift_calibration;
+    if (wc_loop_init(&loop, wc_arm_calibration, &config, SHIFT_OIL_degC) != WC_CAL_OK) {
+        fail("shift: wc_loop_init");
+        return;
+    }
+    ctx.loop = &loop;
+    shift_plant_t plant = {SHIFT_START_SLIP_rad_s, false};
+    uint32_t reports = 0u;
+    uint32_t safe_in_shift = 0u;
+    uint8_t alive = 0u;
+    uint32_t frames_in = 0u;
+    for (uint32_t k = 0u; (k < SHIFT_MAX_PERIODS) && (reports == 0u); ++k) {
+        queue_shift_frames(plant.slip_rad_s, k >= SHIFT_LOOP_SETTLE_PERIODS, alive);
+        frames_in += 3u;
+        alive = wc_e2e_counter_next(alive);
+        const uint32_t safe_before = loop.counters.safe_steps;
+        if (loop.shift.phase == (uint32_t)WC_SHIFT_INERTIA) {
+            record(ROW_LOOP_STEP_SHIFT, measure(thunk_loop_step, &ctx));
+            if (loop.counters.safe_steps != safe_before) { safe_in_shift++; }
+        } else {
+            thunk_loop_step(&ctx);
+        }
+        if (ctx.tx_frames == WC_LOOP_TX_FRAMES) { reports++; }
+        plant_advance(&plant, loop.shift.phase, &loop.last);
+    }
+    /* E2E: SyncCounter frames of each of the three inputs are not used */
+    const uint32_t sync = loop.counters.rejected[WC_REJECT_SYNC];
+    if ((reports != 1u) || (loop.shift.phase != (uint32_t)WC_SHIFT_LOCKED) || (loop.report.abort_reason != 0u) ||
+        (safe_in_shift != 0u) || (loop.counters.frames_used + sync != frames_in)) {
+        wc_arm_puts("SHIFT loop phase ");
+        wc_arm_put_u32(loop.shift.phase);
+        wc_arm_puts(", abort reason ");
+        wc_arm_put_u32(loop.report.abort_reason);
+        wc_arm_puts(", reports ");
+        wc_arm_put_u32(reports);
+        wc_arm_puts(", frames used ");
+        wc_arm_put_u32(loop.counters.frames_used);
+        wc_arm_puts(" + sync ");
+        wc_arm_put_u32(sync);
+        wc_arm_puts(" of ");
+        wc_arm_put_u32(frames_in);
+        wc_arm_puts("\n");
+        fail("wc_loop_step (Shift mode): the shift did not complete, or a frame was rejected");
+    }
+    wc_arm_puts("SHIFT wc_loop_step: inertia phase ");
+    wc_arm_put_u32((uint32_t)lroundf(loop.report.inertia_time_s * 1000.0f));
+    wc_arm_puts(" ms\n");
 }
 
 static uint32_t median_of(row_t row)
@@ -531,6 +739,9 @@ int main(void)
                 }
             }
         }
+
+        bench_shift_step();
+        bench_loop_shift();
 
         wc_arm_puts("GRID ");
         wc_arm_put_u32((uint32_t)GRID_POINTS);

@@ -1,4 +1,4 @@
-"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay,film-study}``."""
+"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay,film-study,shift}``."""
 from __future__ import annotations
 
 import argparse
@@ -172,6 +172,17 @@ def _cmd_film_study(args) -> int:
     return 0
 
 
+def _cmd_shift(args) -> int:
+    from . import shift  # the plant and the closed loop only when needed
+    metrics = shift.report(Path(args.out), plant_path=args.plant)
+    print(Path(args.out, "shift_report.md").read_text())
+    print(f"wrote {args.out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"]))
+    if metrics["missed"]:
+        print("wetclutch shift: targets missed: " + ", ".join(metrics["missed"]), file=sys.stderr)
+        return 1
+    return 0
+
+
 def _cmd_convert(args) -> int:
     from . import bench
     stats = bench.convert_log(args.input, args.output, channel=args.channel)
@@ -224,6 +235,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip comparing every TCU step with the double-precision reference")
     q.set_defaults(func=_cmd_replay)
 
+    q = sub.add_parser("shift", help="closed-loop 1->2 upshifts on a plant: (a) feedback, (b) 2-DOF thermal-blind,"
+                       " (c) 2-DOF full model over the scenario matrix (issue 13); exit 1 when a target is missed")
+    q.add_argument("--plant", default=str(Path(__file__).resolve().parents[1] / "plants" / "upshift_1_2.toml"),
+                   help="plant TOML (default tools/plants/upshift_1_2.toml)")
+    q.add_argument("--out", default="out/shift", help="output directory (default out/shift)")
+    q.set_defaults(func=_cmd_shift)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")
     q.add_argument("--out", default="out/film_study", help="output directory (default out/film_study)")

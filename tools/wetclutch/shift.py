@@ -85,7 +85,7 @@ def scenario_matrix(nominal_oil_degC: float = 80.0) -> list[Scenario]:
     -/+10 % (model error), a heat soak of SOAK_SHIFTS full-load shifts. Nominal: 80 degC, 100 %, friction 1."""
     out = [Scenario(f"oil{int(t)}", t, 1.0, group="oil") for t in (20.0, 40.0, 60.0, 80.0, 100.0, 110.0)]
     out += [Scenario(f"load{int(x * 100)}", nominal_oil_degC, x, group="load") for x in (0.25, 0.5)]
-    out += [Scenario(f"friction{s:+.0%}".replace("%", "pct"), nominal_oil_degC, 1.0, s, group="friction")
+    out += [Scenario(f"friction{round((s - 1.0) * 100):+d}pct", nominal_oil_degC, 1.0, s, group="friction")
             for s in (0.9, 1.1)]
     out.append(Scenario("soak", nominal_oil_degC, 1.0, shifts=SOAK_SHIFTS, group="soak"))
     return out
@@ -291,3 +291,179 @@ def worst(qs: list[dict]) -> dict:
     out["abort_reason"] = ABORT_NAMES.get(out["abort"], str(out["abort"]))
     out["shifts"] = len(qs)
     return out
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The comparison (issue 13): scenario matrix x controllers, targets, report.
+
+INERTIA_TOLERANCE = 0.05         # (c) inertia phase within +-5 % of its target at every oil temperature
+JERK_LIMIT_M_S3 = 10.0           # (c) peak jerk in the nominal scenario (comfort limit about 10-12 m/s^3)
+PRESSURE_RATIO_TARGET = 3.0      # pressure tracking RMSE without / with the lag compensation
+
+
+def run_matrix(plant_path=plant_mod.DEFAULT_PLANT, controllers=("feedback", "blind", "full"),
+               scenarios=None, keep_records=("oil80", "oil20", "soak")) -> dict:
+    """Every controller on every scenario (in-process); returns {"cases": {controller: {scenario: quality}},
+    "records": {(controller, scenario): [records]}} (records kept only for keep_records)."""
+    params = plant_mod.load_plant(plant_path)
+    cal_set = shift_calibration.load(SHIFT_TOML)
+    scenarios = scenarios or scenario_matrix()
+    cases, records = {}, {}
+    for ctrl in controllers:
+        cases[ctrl] = {}
+        for sc in scenarios:
+            recs = run_case(params, f"shift_1_2_{ctrl}", sc, shift_cal=cal_set.variants[ctrl])
+            qs = [quality(r) for r in recs]
+            cases[ctrl][sc.name] = worst(qs)
+            if sc.shifts > 1:
+                cases[ctrl][sc.name]["per_shift"] = qs
+            if sc.name in keep_records:
+                records[(ctrl, sc.name)] = recs
+    return {"plant": str(plant_path), "scenarios": [sc.__dict__ for sc in scenarios], "cases": cases,
+            "records": records}
+
+
+def targets(cases: dict, nolag: dict | None) -> dict:
+    """Issue 13's targets from the matrix: {name: {"met": bool, "detail": ...}}."""
+    out = {}
+    full, a, b = cases["full"], cases.get("feedback", {}), cases.get("blind", {})
+    ratios = {}
+    for sc, q in full.items():
+        ra = {k: (a[sc][k] / q[k] if q[k] > 0 else float("inf")) for k in ("slip_rmse_rpm", "peak_jerk_m_s3")} if sc in a else {}
+        rb = {k: (b[sc][k] / q[k] if q[k] > 0 else float("inf")) for k in ("slip_rmse_rpm", "peak_jerk_m_s3")} if sc in b else {}
+        ratios[sc] = {"vs_a": ra, "vs_b": rb}
+    beats = all(v > 1.0 for r in ratios.values() for side in r.values() for v in side.values())
+    out["c_beats_a_and_b"] = {"met": beats, "ratios": ratios,
+                              "what": "(c) lower slip RMSE and peak jerk than (a) and (b) in every scenario"}
+    oil = {sc: q["inertia_time_error"] for sc, q in full.items() if sc.startswith("oil")}
+    out["c_inertia_time_within_5pct"] = {"met": all(math.isfinite(e) and abs(e) <= INERTIA_TOLERANCE for e in oil.values()),
+                                         "errors": oil}
+    nominal = full.get(NOMINAL)
+    out["c_nominal_jerk_le_10"] = {"met": bool(nominal and nominal["peak_jerk_m_s3"] <= JERK_LIMIT_M_S3),
+                                   "peak_jerk_m_s3": nominal["peak_jerk_m_s3"] if nominal else None}
+    bad = {sc: [k for k in ("flare", "tie_up") if q[k]] + ([q["abort_reason"]] if q["abort"] != 0 else [])
+           for sc, q in full.items()}
+    out["c_no_flare_tieup_abort"] = {"met": not any(bad.values()), "problems": {k: v for k, v in bad.items() if v}}
+    if nolag is not None and NOMINAL in full:
+        with_lc, without = full[NOMINAL]["pressure_rmse_kPa"], nolag["pressure_rmse_kPa"]
+        out["lag_compensation_3x"] = {"met": without >= PRESSURE_RATIO_TARGET * with_lc, "with_kPa": with_lc,
+                                      "without_kPa": without, "ratio": without / with_lc if with_lc > 0 else float("inf")}
+    return out
+
+
+def _fmt(x, nd=1):
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, (int, np.integer)):
+        return str(x)
+    return "n/a" if not math.isfinite(x) else f"{x:.{nd}f}"
+
+
+def markdown(cases: dict, tg: dict) -> str:
+    lines = ["# 1->2 upshift: (a) feedback only, (b) 2-DOF thermal-blind, (c) 2-DOF full model", "",
+             "Quality per controller and scenario, from the plant's truth (tools/wetclutch/shift.py); the heat soak"
+             " row is the worst of its shifts.", "",
+             "| scenario | ctrl | inertia s (err %) | slip RMSE rpm | peak jerk m/s^3 | energy kJ | peak theta degC"
+             " (est.) | p RMSE kPa | flare | tie-up | end |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    names = list(next(iter(cases.values())).keys())
+    for sc in names:
+        for ctrl, label in (("feedback", "a"), ("blind", "b"), ("full", "c")):
+            if ctrl not in cases:
+                continue
+            q = cases[ctrl][sc]
+            lines.append(f"| {sc} | {label} | {_fmt(q['inertia_time_s'], 3)} ({_fmt(100 * q['inertia_time_error'])}) |"
+                         f" {_fmt(q['slip_rmse_rpm'])} | {_fmt(q['peak_jerk_m_s3'])} | {_fmt(q['friction_energy_kJ'], 2)} |"
+                         f" {_fmt(q['peak_theta_degC'])} ({_fmt(q['peak_theta_estimate_degC'])}) |"
+                         f" {_fmt(q['pressure_rmse_kPa'])} | {_fmt(q['flare'])} | {_fmt(q['tie_up'])} | {q['abort_reason']} |")
+    lines += ["", "## Ratios (a)/(c) and (b)/(c): > 1 means (c) is better", "",
+              "| scenario | slip RMSE a/c | jerk a/c | slip RMSE b/c | jerk b/c |", "|---|---|---|---|---|"]
+    for sc, r in tg["c_beats_a_and_b"]["ratios"].items():
+        lines.append(f"| {sc} | {_fmt(r['vs_a'].get('slip_rmse_rpm', float('nan')), 2)} |"
+                     f" {_fmt(r['vs_a'].get('peak_jerk_m_s3', float('nan')), 2)} |"
+                     f" {_fmt(r['vs_b'].get('slip_rmse_rpm', float('nan')), 2)} |"
+                     f" {_fmt(r['vs_b'].get('peak_jerk_m_s3', float('nan')), 2)} |")
+    lines += ["", "## Targets", ""]
+    for name, t in tg.items():
+        detail = {k: v for k, v in t.items() if k not in ("met", "ratios")}
+        lines.append(f"- **{name}**: {'met' if t['met'] else 'MISSED'} {json.dumps(detail, default=float)[:400]}")
+    return "\n".join(lines) + "\n"
+
+
+def plot_case(path: Path, runs: dict, title: str) -> None:
+    """Fig. 4-style panels of one scenario, the controllers overlaid: speeds, slip and its reference, clutch
+    torque, pressure and current, vehicle acceleration and jerk, clutch temperature (true and estimated)."""
+    from . import plotting
+    fig, axes = plotting.subplots(3, 2, figsize=(13, 11), sharex=True)
+    colors = {"feedback": "tab:red", "blind": "tab:orange", "full": "tab:blue", "nolag": "tab:gray"}
+    for ctrl, rec in runs.items():
+        c = colors.get(ctrl, "k")
+        k0 = rec["command_step"]
+        t = rec["t_s"] - rec["t_s"][k0]
+        lab = {"feedback": "(a) feedback", "blind": "(b) 2-DOF blind", "full": "(c) 2-DOF full", "nolag": "(c) no lag comp."}[ctrl]
+        ax = axes[0, 0]
+        ax.plot(t, rec["true_turbine_speed_rpm"], color=c, label=f"turbine {lab}")
+        if ctrl == "full":
+            ax.plot(t, rec["true_gear1_speed_rpm"], "k:", lw=1, label="1st-gear sync (i1 w_o)")
+            ax.plot(t, rec["true_gear2_speed_rpm"], "k--", lw=1, label="2nd-gear sync (i2 w_o)")
+        ax = axes[0, 1]
+        ax.plot(t, rec["true_slip_rad_s"] / plant_mod.RPM, color=c, label=f"slip {lab}")
+        ax.plot(t, rec["reference_slip_rad_s"] / plant_mod.RPM, color=c, ls="--", lw=1)
+        ax = axes[1, 0]
+        ax.plot(t, rec["true_clutch_torque_Nm"], color=c, label=f"true {lab}")
+        ax.plot(t, rec["model_torque_Nm"], color=c, ls=":", lw=1)
+        ax = axes[1, 1]
+        ax.plot(t, rec["pressure_command_Pa"] * 1e-3, color=c, ls="--", lw=1)
+        ax.plot(t, rec["true_pressure_Pa"] * 1e-3, color=c, label=f"piston {lab}")
+        ax = axes[2, 0]
+        dt = rec["t_s"][1] - rec["t_s"][0]
+        acc = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
+        ax.plot(t, acc, color=c, label=f"accel {lab}")
+        ax.plot(t, np.gradient(acc, dt) / 10.0, color=c, ls=":", lw=1)
+        ax = axes[2, 1]
+        ax.plot(t, rec["true_theta_clutch_degC"], color=c, label=f"true {lab}")
+        ax.plot(t, rec["theta_estimate_degC"], color=c, ls="--", lw=1)
+    plotting.style(axes[0, 0], ylabel="speed (rpm)", title="turbine and synchronous speeds", legend={"fontsize": 7})
+    plotting.style(axes[0, 1], ylabel="slip (rpm)", title="slip (solid) and reference (dashed)", legend={"fontsize": 7})
+    plotting.style(axes[1, 0], ylabel="torque (Nm)", title="on-coming clutch torque: true (solid), TCU model (dotted)",
+                   legend={"fontsize": 7})
+    plotting.style(axes[1, 1], ylabel="pressure (kPa)", title="piston pressure (solid) and TCU's wanted pressure (dashed)",
+                   legend={"fontsize": 7})
+    plotting.style(axes[2, 0], xlabel="time from shift command (s)", ylabel="m/s^2  |  jerk / 10 (m/s^3)",
+                   title="vehicle acceleration (10 Hz) and jerk/10 (dotted)", legend={"fontsize": 7})
+    plotting.style(axes[2, 1], xlabel="time from shift command (s)", ylabel="degC",
+                   title="clutch temperature: true (solid), TCU estimate (dashed)", legend={"fontsize": 7})
+    for ax in axes.flat:
+        ax.set_xlim(-0.05, 1.0)
+    fig.suptitle(title)
+    plotting.save(fig, path)
+
+
+def report(out_dir: Path, plant_path=plant_mod.DEFAULT_PLANT, scenarios=None) -> dict:
+    """Run the comparison and write metrics.json, shift_report.md and the Fig. 4-style plots."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    res = run_matrix(plant_path, scenarios=scenarios)
+    params = plant_mod.load_plant(plant_path)
+    cal_set = shift_calibration.load(SHIFT_TOML)
+    nominal = next((sc for sc in (scenarios or scenario_matrix()) if sc.name == NOMINAL), None)
+    nolag = None
+    if nominal is not None:
+        nolag_recs = run_case(params, "shift_1_2_nolag", nominal, shift_cal=cal_set.variants["nolag"])
+        nolag = quality(nolag_recs[0])
+        res["records"][("nolag", NOMINAL)] = nolag_recs
+    tg = targets(res["cases"], nolag)
+    plots = []
+    for sc in ("oil80", "oil20", "soak"):
+        runs = {ctrl: recs[-1] for (ctrl, name), recs in res["records"].items() if name == sc}
+        if runs:
+            path = out_dir / f"shift_{sc}.png"
+            plot_case(path, runs, f"1->2 upshift, scenario {sc} ({Path(plant_path).name})"
+                      + (" - last shift of the soak" if sc == "soak" else ""))
+            plots.append(str(path))
+    metrics = {"plant": str(plant_path), "target_inertia_s": TARGET_INERTIA_S, "cases": res["cases"],
+               "nolag_nominal": nolag, "targets": tg, "plots": plots,
+               "missed": [k for k, t in tg.items() if not t["met"]]}
+    with Staged() as staged:
+        staged.write_text(out_dir / "metrics.json", json.dumps(metrics, indent=1, default=float, sort_keys=True))
+        staged.write_text(out_dir / "shift_report.md", markdown(res["cases"], tg))
+    return metrics
