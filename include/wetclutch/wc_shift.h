@@ -24,7 +24,8 @@
  *             carried_torque_Nm) and the model locks (wc_lockup, DESIGN 9);
  *             LOCKED once locked and the ramp done; not locked after twice
  *             the ramp time: abort.
- *   LOCKED    shift complete; the holding request stays until the command ends.
+ *   LOCKED    shift complete; the holding request stays until the command ends
+ *             or the safe state begins (then IDLE: released).
  *   ABORTED   released to the safe state (minimum current) until the command
  *             ends; the report says why.
  * The report (wc_shift_report_t) is produced once, on entering LOCKED or
@@ -185,7 +186,11 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
  * aborts with WC_SHIFT_ABORT_INPUT_LOST). Builds the clutch input from
  * sensors (slip and temperatures; mode and request are the controller's),
  * steps the clutch (wc_clutch_step) and updates the quality vector. Returns
- * true when the shift ended this step; *report then holds its quality vector. */
+ * true when the shift ended this step; *report then holds its quality vector.
+ * out must hold the previous step's output (zero-initialised before the
+ * first): its WC_STATUS_SATURATED stops the integral (anti-windup). A request
+ * bit already 1 when the safe state ends starts no shift: a new 0 -> 1 edge
+ * is needed (no restart without the VCU's consent). */
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                    bool safe, wc_clutch_t *clutch, const wc_step_input_t *sensors, wc_step_output_t *out,
                    wc_shift_report_t *report);

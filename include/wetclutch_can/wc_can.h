@@ -587,7 +587,7 @@ struct wc_can_clutch_estimate_t {
 /**
  * Signals in message ShiftReport.
  *
- * Shift report, sent once when a shift ends (locked or aborted), in the step's output after VfsCommand and before ClutchEstimate. The quality vector of the shift (DESIGN 10) as the TCU estimates it.
+ * Shift report, sent once when a shift ends (locked or aborted), in the step's output after VfsCommand and ClutchEstimate. The quality vector of the shift (DESIGN 10) as the TCU estimates it.
  *
  * All signal values are as on the CAN bus.
  */

@@ -192,8 +192,8 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     if (safe || !command->request) {
         if (running(shift->phase)) {
             abort_shift(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
-        } else if (!command->request) {
-            enter(shift, WC_SHIFT_IDLE);
+        } else if (!command->request || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
+            enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
         start(shift, command, slip_rad_s);

@@ -43,7 +43,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import subprocess
+import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -132,6 +134,96 @@ class InprocTcu:
         self.proc.wait(timeout=10)
         self.proc.stdout.close()
         self.proc.stderr.close()
+
+
+class VcanTcu:
+    """The TCU program on a SocketCAN interface: wc_tcu --clock frame --shift NAME, frames through python-can.
+    Each exchange sends the period's frames and returns what the TCU sent up to its ClutchEstimate (a
+    ShiftReport, sent after it, comes with the next exchange: the frame sequence is the same as in-process)."""
+
+    def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
+                 calibration: str = TCU_CALIBRATION, iface: str = "vcan0", log_dir: Path | None = None):
+        import can
+        if overrides:
+            raise ShiftError("wc_tcu takes compiled-in shift calibrations only (no overrides)")
+        program = ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
+        if not program.is_file():
+            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
+        db = canlog.database()
+        self.ids = {db.get_message_by_name(n).frame_id for n in (canlog.COMMAND, canlog.ESTIMATE, canlog.SHIFT_REPORT)}
+        self.estimate_id = db.get_message_by_name(canlog.ESTIMATE).frame_id
+        self.bus = can.Bus(interface="socketcan", channel=iface,
+                           can_filters=[{"can_id": i, "can_mask": 0x7FF, "extended": False} for i in sorted(self.ids)])
+        self.log = Path(log_dir or ".") / "wc_tcu_shift.txt"
+        self.log_file = open(self.log, "w")
+        self.proc = subprocess.Popen([str(program), "--iface", iface, "--clock", "frame", "--calibration", calibration,
+                                      "--shift", shift_name, "--theta-start", f"{theta_start_degC:.6g}"],
+                                     stdout=subprocess.DEVNULL, stderr=self.log_file)
+        import time
+        for _ in range(200):
+            if "clock frame" in self.log.read_text() or self.proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        if self.proc.poll() is not None or "clock frame" not in self.log.read_text():
+            raise ShiftError(f"wc_tcu did not start: {self.log.read_text().strip()}")
+
+    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
+        for m in frames:
+            self.bus.send(m)
+        out = []
+        while True:
+            msg = self.bus.recv(timeout=10.0)
+            if msg is None:
+                raise ShiftError(f"no answer from wc_tcu at t = {t_s:.3f} s: {self.log.read_text().strip()[-400:]}")
+            if msg.arbitration_id not in self.ids or msg.is_error_frame:
+                continue
+            out.append((msg.arbitration_id, bytes(msg.data)))
+            if msg.arbitration_id == self.estimate_id:
+                return out
+
+    def close(self):
+        import signal
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            self.proc.wait(timeout=10)
+        finally:
+            self.bus.shutdown()
+            self.log_file.close()
+
+
+def frame_sequence(records: list[dict]) -> list[tuple[int, str]]:
+    """The TCU's output frames of a case in order (id, hex), for the in-process / vcan comparison."""
+    return [(fid, data) for rec in records for _, fid, data in rec["frames"]]
+
+
+def run_on_vcan(out_dir: Path, shift_name: str = "shift_1_2_full", scenario_name: str = NOMINAL,
+                plant_path=plant_mod.DEFAULT_PLANT) -> Path:
+    """One closed-loop shift against wc_tcu on vcan0 (natively or in the QEMU guest, hil/vcan_run.sh);
+    writes out_dir/vcan_frames.json and returns its path."""
+    out_dir = Path(out_dir).resolve()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out_dir), "--",
+           str(ROOT / ".venv" / "bin" / "python"), "-m", "wetclutch.shift", "--vcan-guest", str(out_dir),
+           shift_name, scenario_name, str(plant_path)]
+    env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
+    result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
+    if result.returncode != 0:
+        raise ShiftError(f"closed-loop shift on vcan failed (exit {result.returncode}); see {out_dir}")
+    return out_dir / "vcan_frames.json"
+
+
+def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: str) -> int:
+    """Guest side of run_on_vcan: the case against wc_tcu on vcan0, frames and quality to JSON."""
+    sc = next(s for s in scenario_matrix() if s.name == scenario_name)
+    params = plant_mod.load_plant(plant_path)
+    tcu = VcanTcu(shift_name, sc.oil_degC, log_dir=Path(out_dir))
+    try:
+        recs = run_case(params, shift_name, sc, tcu=tcu)
+    finally:
+        tcu.close()
+    payload = {"frames": frame_sequence(recs), "quality": [quality(r) for r in recs]}
+    Path(out_dir, "vcan_frames.json").write_text(json.dumps(payload, default=float))
+    return 0
 
 
 def reference_slip(start_rad_s: float, target_s: float, elapsed_s: np.ndarray) -> np.ndarray:
@@ -467,3 +559,10 @@ def report(out_dir: Path, plant_path=plant_mod.DEFAULT_PLANT, scenarios=None) ->
         staged.write_text(out_dir / "metrics.json", json.dumps(metrics, indent=1, default=float, sort_keys=True))
         staged.write_text(out_dir / "shift_report.md", markdown(res["cases"], tg))
     return metrics
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 6 and sys.argv[1] == "--vcan-guest":
+        sys.exit(_vcan_guest(*sys.argv[2:]))
+    print("usage: python -m wetclutch.shift --vcan-guest OUT_DIR SHIFT_NAME SCENARIO PLANT_TOML", file=sys.stderr)
+    sys.exit(2)
