@@ -1,0 +1,132 @@
+"""Closed-loop 1->2 upshifts (issue 13): the shift calibration, the comparison of the three controllers on
+the plant (in-process, the full scenario matrix), determinism, and one shift on vcan against the same
+case in-process (identical frames)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from vcan_support import needs_vcan
+from wetclutch import plant, shift, shift_calibration
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_shift_header_regenerates_byte_identically(tmp_path):
+    subprocess.run([sys.executable, "-m", "wetclutch.cli", "lut", "tools/calibrations/shift_1_2.toml", "--out",
+                    str(tmp_path)], cwd=ROOT, check=True, capture_output=True)
+    name = "wc_shift_1_2_shift.h"
+    assert (tmp_path / name).read_bytes().replace(str(tmp_path).encode(), b"lut") == (ROOT / "lut" / name).read_bytes()
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("kp", "-1.0", "kp = -1.0 outside"),
+    ("lag_compensation_time", "0.0005", "lag_compensation_time = 0.0005.* outside"),
+    ("theta_source", "2", "theta_source = 2 outside"),
+    ("inertia_timeout_factor", "nan", "not finite"),
+])
+def test_shift_calibration_refuses_what_the_firmware_refuses(tmp_path, field, value, message):
+    text = (ROOT / "tools" / "calibrations" / "shift_1_2.toml").read_text()
+    lines = [(f'{field} = {{ value = {value}, unit = "{line.split("unit = ")[1].split(chr(34))[1]}", source = "x" }}'
+              if line.split("=")[0].strip() == field and line.startswith(field) else line) for line in text.splitlines()]
+    bad = tmp_path / "bad.toml"
+    bad.write_text("\n".join(lines))
+    with pytest.raises(shift_calibration.ShiftCalibrationError, match=message):
+        shift_calibration.load(bad)
+
+
+def test_unknown_and_missing_parameters_are_errors(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[shift]\nkp = { value = 1.0, unit = "Nm/(rad/s)", source = "x" }\n')
+    with pytest.raises(shift_calibration.ShiftCalibrationError, match="missing"):
+        shift_calibration.load(bad)
+    bad.write_text((ROOT / "tools" / "calibrations" / "shift_1_2.toml").read_text()
+                   + '\n[variants.x]\nkq = { value = 1.0, unit = "1", source = "x" }\n')
+    with pytest.raises(shift_calibration.ShiftCalibrationError, match="unknown parameter"):
+        shift_calibration.load(bad)
+
+
+def test_in_process_shift_is_deterministic():
+    params = plant.load_plant(plant.DEFAULT_PLANT)
+    nominal = next(s for s in shift.scenario_matrix() if s.name == shift.NOMINAL)
+    a = shift.frame_sequence(shift.run_case(params, "shift_1_2_full", nominal))
+    b = shift.frame_sequence(shift.run_case(params, "shift_1_2_full", nominal))
+    assert len(a) > 3000 and a == b
+
+
+@pytest.fixture(scope="module")
+def matrix(tmp_path_factory):
+    """The README's shift command: the full matrix in-process (about a minute)."""
+    out = tmp_path_factory.mktemp("shift")
+    result = subprocess.run([sys.executable, "-m", "wetclutch.cli", "shift", "--out", str(out)], cwd=ROOT,
+                            capture_output=True, text=True)
+    metrics = json.loads((out / "metrics.json").read_text())
+    return out, result, metrics
+
+
+def test_report_has_every_case_and_the_plots(matrix):
+    out, result, metrics = matrix
+    assert set(metrics["cases"]) == {"feedback", "blind", "full"}
+    names = {s.name for s in shift.scenario_matrix()}
+    for ctrl, cases in metrics["cases"].items():
+        assert set(cases) == names, ctrl
+    assert len(metrics["cases"]["full"]["soak"]["per_shift"]) == shift.SOAK_SHIFTS
+    for png in ("shift_oil80.png", "shift_oil20.png", "shift_soak.png"):
+        assert (out / png).stat().st_size > 50_000, png
+    # the exit code says whether a target was missed
+    assert result.returncode == (1 if metrics["missed"] else 0), result.stderr
+
+
+def test_full_model_beats_feedback_and_thermal_blind_everywhere(matrix):
+    t = matrix[2]["targets"]["c_beats_a_and_b"]
+    assert t["met"], json.dumps(t["ratios"], indent=1)
+
+
+def test_lag_compensation_tracks_pressure_3x_better(matrix):
+    t = matrix[2]["targets"]["lag_compensation_3x"]
+    assert t["met"] and t["ratio"] >= 3.0, t
+
+
+# Targets measured and missed (closing note of issue 13); strict: passing them turns these into failures,
+# so the marks come off when the controller meets them.
+@pytest.mark.xfail(strict=True, reason="missed: (c) inertia time -9 % at 20 degC ... +10 % at 110 degC (target +-5 %)")
+def test_inertia_time_within_5_percent_at_every_oil_temperature(matrix):
+    t = matrix[2]["targets"]["c_inertia_time_within_5pct"]
+    assert t["met"], t["errors"]
+
+
+@pytest.mark.xfail(strict=True, reason="missed: (c) nominal peak jerk 17.6 m/s^3 (target 10): the lock-up")
+def test_nominal_peak_jerk_within_comfort_limit(matrix):
+    t = matrix[2]["targets"]["c_nominal_jerk_le_10"]
+    assert t["met"], t
+
+
+@pytest.mark.xfail(strict=True, reason="missed: (c) flares at 20 and 40 degC oil (open-clutch drag, film lag)")
+def test_full_model_no_flare_tie_up_or_abort(matrix):
+    t = matrix[2]["targets"]["c_no_flare_tieup_abort"]
+    assert t["met"], t["problems"]
+
+
+def test_full_model_never_aborts(matrix):
+    """The part of the last target that holds: (c) completes every shift of every scenario."""
+    full = matrix[2]["cases"]["full"]
+    assert {sc: q["abort_reason"] for sc, q in full.items() if q["abort"] != 0} == {}
+    assert all(q["abort"] == 0 for q in full["soak"]["per_shift"])
+
+
+@needs_vcan
+def test_vcan_shift_equals_in_process(tmp_path):
+    """One closed-loop shift against wc_tcu on vcan (natively or in the QEMU guest) gives exactly the frames of
+    the same case with the frame loop in-process."""
+    path = shift.run_on_vcan(tmp_path)
+    vcan = json.loads(path.read_text())
+    params = plant.load_plant(plant.DEFAULT_PLANT)
+    nominal = next(s for s in shift.scenario_matrix() if s.name == shift.NOMINAL)
+    inproc = [list(f) for f in shift.frame_sequence(shift.run_case(params, "shift_1_2_full", nominal))]
+    assert len(vcan["frames"]) == len(inproc) > 3000
+    assert vcan["frames"] == inproc
+    assert vcan["quality"][0]["abort"] == 0
