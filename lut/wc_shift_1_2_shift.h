@@ -9,6 +9,8 @@
 static const wc_shift_calibration_t wc_shift_1_2_full = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
     .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
@@ -33,6 +35,8 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
 static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
     .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
@@ -57,6 +61,8 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
 static const wc_shift_calibration_t wc_shift_1_2_feedback = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
     .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
@@ -81,6 +87,8 @@ static const wc_shift_calibration_t wc_shift_1_2_feedback = {
 static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
     .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
     .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
     .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
     .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */

@@ -524,6 +524,8 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
 static const wc_shift_calibration_t shift_calibration = {
     .turbine_inertia_kg_m2 = 0.25f,
     .turbine_ratio = 1.0f,
+    .output_inertia_kg_m2 = 1e5f,
+    .output_ratio = 1.0f,
     .jerk_per_torque_rate = 0.01f,
     .prepare_time_s = 0.05f,
     .torque_phase_time_s = 0.1f,

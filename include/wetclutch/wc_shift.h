@@ -70,6 +70,8 @@ typedef struct {
     /* The TCU's driveline model (DESIGN 10): the turbine side and the clutch's kinematics. */
     float turbine_inertia_kg_m2;       /* I_t: turbine + engine (converter locked) */
     float turbine_ratio;               /* a in slip = a w_t - b w_o: clutch slip per turbine speed */
+    float output_inertia_kg_m2;        /* I_o plus the vehicle referred to the output shaft, m r_w^2 / r_f^2 */
+    float output_ratio;                /* b: clutch slip per output speed (the target gear's ratio) */
     float jerk_per_torque_rate;        /* vehicle jerk per on-coming clutch torque rate, (m/s^3) / (Nm/s): b r_f / (m r_w) */
     /* Phases */
     float prepare_time_s;
@@ -100,6 +102,8 @@ typedef enum {
     WC_SHIFT_CAL_NULL,
     WC_SHIFT_CAL_TURBINE_INERTIA,
     WC_SHIFT_CAL_TURBINE_RATIO,
+    WC_SHIFT_CAL_OUTPUT_INERTIA,
+    WC_SHIFT_CAL_OUTPUT_RATIO,
     WC_SHIFT_CAL_JERK_PER_TORQUE_RATE,
     WC_SHIFT_CAL_PREPARE_TIME,
     WC_SHIFT_CAL_TORQUE_PHASE_TIME,
@@ -124,7 +128,8 @@ typedef enum {
 /* Limits of wc_shift_calibration_check: every time within [0, 10] s (the
  * inertia times within [0.05, 5] s, the jerk filter and the lag compensation
  * time 0 or >= 1e-3 s), the inertia within (0, 100] kg m^2, the ratio within
- * [0.05, 20], gains within [0, 1e5], factors as commented. */
+ * [0.05, 20], the output inertia within [1e-4, 1e5] kg m^2, gains within
+ * [0, 1e5], factors as commented. */
 #define WC_SHIFT_LIMIT_TIME_MAX_s 10.0f
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s 0.05f
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s 5.0f
@@ -176,9 +181,11 @@ void wc_shift_init(wc_shift_t *shift);
  * clamped to [0, 1]; *rate_rad_s2 its time derivative (0 at both ends). */
 float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2);
 
-/* Feed-forward torque of the inertia phase, DESIGN 10 with the output side
- * quasi-static over the phase (dw_o/dt ~ 0, so T_s ~ b T_c and the b terms
- * cancel): T_ff = (T_t - I_t dref/dt / a) / a, >= 0. */
+/* Feed-forward torque of the inertia phase, DESIGN 10 with a stiff
+ * driveshaft: the vehicle moves with the output shaft, I_o -> I_out = I_o +
+ * m r_w^2 / r_f^2, and T_s -> the road load, taken as 0 (it is small against
+ * the clutch torque and the PI takes it):
+ * T_ff = (a T_t / I_t - dref/dt) / (a^2 / I_t + b^2 / I_out), >= 0. */
 float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2);
 
 /* One control period while the frame loop is in shift mode and not in its

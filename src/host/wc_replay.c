@@ -63,7 +63,8 @@ typedef struct {
 } shift_field_t;
 #define SHIFT_FIELD(f) { #f, offsetof(wc_shift_calibration_t, f) }
 static const shift_field_t shift_fields[] = {
-    SHIFT_FIELD(turbine_inertia_kg_m2), SHIFT_FIELD(turbine_ratio), SHIFT_FIELD(jerk_per_torque_rate),
+    SHIFT_FIELD(turbine_inertia_kg_m2), SHIFT_FIELD(turbine_ratio), SHIFT_FIELD(output_inertia_kg_m2),
+    SHIFT_FIELD(output_ratio), SHIFT_FIELD(jerk_per_torque_rate),
     SHIFT_FIELD(prepare_time_s), SHIFT_FIELD(torque_phase_time_s), SHIFT_FIELD(inertia_time_min_s),
     SHIFT_FIELD(inertia_time_max_s), SHIFT_FIELD(inertia_timeout_factor), SHIFT_FIELD(lockup_ramp_time_s),
     SHIFT_FIELD(holding_torque_factor), SHIFT_FIELD(min_start_slip_rad_s), SHIFT_FIELD(feedforward_gain),

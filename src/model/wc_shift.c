@@ -17,6 +17,8 @@ wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *ca
     const float tmax = WC_SHIFT_LIMIT_TIME_MAX_s;
     if (!in_closed(cal->turbine_inertia_kg_m2, 1e-4f, 100.0f)) { return WC_SHIFT_CAL_TURBINE_INERTIA; }
     if (!in_closed(cal->turbine_ratio, 0.05f, 20.0f)) { return WC_SHIFT_CAL_TURBINE_RATIO; }
+    if (!in_closed(cal->output_inertia_kg_m2, 1e-4f, 1e5f)) { return WC_SHIFT_CAL_OUTPUT_INERTIA; }
+    if (!in_closed(cal->output_ratio, 0.05f, 20.0f)) { return WC_SHIFT_CAL_OUTPUT_RATIO; }
     if (!in_closed(cal->jerk_per_torque_rate, 0.0f, 1.0f)) { return WC_SHIFT_CAL_JERK_PER_TORQUE_RATE; }
     if (!in_closed(cal->prepare_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_PREPARE_TIME; }
     if (!in_closed(cal->torque_phase_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_TORQUE_PHASE_TIME; }
@@ -66,11 +68,13 @@ float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float
 
 float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2)
 {
-    /* DESIGN 10: T_ff = (a T_t / I_t + b T_s / I_o - dref/dt) / (a^2 / I_t + b^2 / I_o);
-     * with T_s = b T_c - I_o dw_o/dt and dw_o/dt ~ 0 the b terms cancel:
-     * T_ff = (T_t - I_t dref/dt / a) / a. */
+    /* DESIGN 10: T_ff = (a T_t / I_t + b T_s / I_o - dref/dt) / (a^2 / I_t + b^2 / I_o),
+     * stiff driveshaft: I_o -> I_out (output shaft + vehicle), T_s -> road load ~ 0 */
     const float a = cal->turbine_ratio;
-    const float t_ff = (turbine_torque_Nm - cal->turbine_inertia_kg_m2 * reference_rate_rad_s2 / a) / a;
+    const float b = cal->output_ratio;
+    const float i_t = cal->turbine_inertia_kg_m2;
+    const float t_ff = (a * turbine_torque_Nm / i_t - reference_rate_rad_s2) /
+                       (a * a / i_t + b * b / cal->output_inertia_kg_m2);
     return (t_ff > 0.0f) ? ((t_ff < WC_TORQUE_MAX_Nm) ? t_ff : WC_TORQUE_MAX_Nm) : 0.0f;
 }
 

@@ -41,6 +41,8 @@
 static const wc_shift_calibration_t test_cal = {
     .turbine_inertia_kg_m2 = 0.25f,
     .turbine_ratio = 1.0f,
+    .output_inertia_kg_m2 = 1e5f,  /* the test's plant holds the output speed: an output side that does not move */
+    .output_ratio = 1.0f,
     .jerk_per_torque_rate = 0.01f,
     .prepare_time_s = 0.05f,
     .torque_phase_time_s = 0.1f,
@@ -103,6 +105,8 @@ typedef struct {
 static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(turbine_inertia_kg_m2, WC_SHIFT_CAL_TURBINE_INERTIA, 1e-4f, 100.0f, false),
     SHIFT_FIELD(turbine_ratio, WC_SHIFT_CAL_TURBINE_RATIO, 0.05f, 20.0f, false),
+    SHIFT_FIELD(output_inertia_kg_m2, WC_SHIFT_CAL_OUTPUT_INERTIA, 1e-4f, 1e5f, false),
+    SHIFT_FIELD(output_ratio, WC_SHIFT_CAL_OUTPUT_RATIO, 0.05f, 20.0f, false),
     SHIFT_FIELD(jerk_per_torque_rate, WC_SHIFT_CAL_JERK_PER_TORQUE_RATE, 0.0f, 1.0f, false),
     SHIFT_FIELD(prepare_time_s, WC_SHIFT_CAL_PREPARE_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
     SHIFT_FIELD(torque_phase_time_s, WC_SHIFT_CAL_TORQUE_PHASE_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
@@ -310,8 +314,10 @@ static void test_feedforward_formula(void **state)
             cal.turbine_inertia_kg_m2 = inertias[j];
             for (size_t t = 0u; t < WC_TEST_COUNT(torques); ++t) {
                 for (size_t r = 0u; r < WC_TEST_COUNT(rates); ++r) {
-                    const double expected = ((double)torques[t] - (double)inertias[j] * (double)rates[r] /
-                                             (double)ratios[a]) / (double)ratios[a];
+                    const double ai = (double)ratios[a], it = (double)inertias[j];
+                    const double b = (double)cal.output_ratio, io = (double)cal.output_inertia_kg_m2;
+                    const double expected = (ai * (double)torques[t] / it - (double)rates[r]) /
+                                            (ai * ai / it + b * b / io);  /* DESIGN 10, stiff driveshaft */
                     const float got = wc_shift_feedforward_Nm(&cal, torques[t], rates[r]);
                     /* a few float operations: 1e-6 relative */
                     WC_CHECK_CLOSE("feed-forward", (long)(a * 1000u + j * 100u + t * 10u + r), got, expected, 1e-6,

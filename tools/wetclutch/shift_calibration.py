@@ -37,6 +37,8 @@ SLIP_MAX_RAD_S = 1047.2    # WC_SLIP_MAX_rad_s
 FIELDS: tuple[tuple[str, str, str, object], ...] = (
     ("turbine_inertia", "kg*m^2", "turbine_inertia_kg_m2", lambda v, c: 1e-4 <= v <= 100.0),
     ("turbine_ratio", "1", "turbine_ratio", lambda v, c: 0.05 <= v <= 20.0),
+    ("output_inertia", "kg*m^2", "output_inertia_kg_m2", lambda v, c: 1e-4 <= v <= 1e5),
+    ("output_ratio", "1", "output_ratio", lambda v, c: 0.05 <= v <= 20.0),
     ("jerk_per_torque_rate", "(m/s^3)/(Nm/s)", "jerk_per_torque_rate", lambda v, c: 0.0 <= v <= 1.0),
     ("prepare_time", "s", "prepare_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
     ("torque_phase_time", "s", "torque_phase_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
