@@ -40,11 +40,15 @@ typedef struct {
     float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
     wc_clutch_mode_t mode;
     wc_bench_input_t bench;    /* zero-initialized: not on a bench */
-    /* Hydraulic-lag compensation (DESIGN 9): 0 (zero-initialized) commands the
-     * steady current of the wanted pressure and leaves the VFS lag (tau) to act;
-     * t > 0 leads the lag so that the modelled pressure approaches the wanted
-     * one with time constant t instead of tau, the current bounded to the
-     * solenoid's range. Not finite or negative: off, WC_STATUS_INPUT_INVALID not set. */
+    /* Lag compensation (DESIGN 9): 0 (zero-initialized) commands the steady
+     * current of the wanted force and leaves the squeeze film and the VFS lag
+     * (tau) to act; t > 0 (WC_MODE_TORQUE) leads both: with the film state on,
+     * the wanted apply force is raised so that the film approaches the wanted
+     * contact force's film with time constant t (never below the steady
+     * force), and the current leads the VFS lag so that the modelled pressure
+     * approaches that force's pressure with time constant t instead of tau;
+     * bounded to F_max and the solenoid's range. Not finite or negative: off,
+     * WC_STATUS_INPUT_INVALID not set. */
     float lag_compensation_time_s;
     /* true: the model (inverse and torque) takes the oil temperature instead of
      * the observer's estimate (a thermal-blind model, for comparisons); the

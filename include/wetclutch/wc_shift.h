@@ -17,13 +17,14 @@
  *             the commanded target time with zero slope at both ends
  *             (smoothstep); request = feed-forward + PI(slip - reference).
  *             Ends when the slip has stayed inside the clutch's lock band
- *             (lock_slip_rad_s) for lock_dwell_periods, or the model locks.
+ *             (lock_slip_rad_s) for lock_dwell_periods, the model locks, or
+ *             the reference has ended (target time elapsed).
  *   LOCKUP    hand-over: the request ramps to holding_torque_factor * T_t / a
  *             in lockup_ramp_time_s, so that the static capacity exceeds the
  *             torque the clutch carries (T_t / a, passed to the lock-up as
  *             carried_torque_Nm) and the model locks (wc_lockup, DESIGN 9);
- *             LOCKED once locked and the ramp done; not locked after twice
- *             the ramp time: abort.
+ *             LOCKED once locked and the ramp done; not locked after
+ *             WC_SHIFT_LOCKUP_WAIT ramp times: abort.
  *   LOCKED    shift complete; the holding request stays until the command ends
  *             or the safe state begins (then IDLE: released).
  *   ABORTED   released to the safe state (minimum current) until the command
@@ -134,6 +135,8 @@ typedef enum {
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s 0.05f
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s 5.0f
 #define WC_SHIFT_LIMIT_GAIN_MAX 1e5f
+/* The hand-over waits this many lockup_ramp_time_s for the lock-up (its dwell, a slow cold film). */
+#define WC_SHIFT_LOCKUP_WAIT 4u
 
 wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal);
 

@@ -74,6 +74,27 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ti
     return WC_STATUS_OK;
 }
 
+/* DESIGN 9, squeeze film, the lead's first half: the apply force that moves
+ * the film state h_bar towards the film h_bar* of the wanted contact force
+ * as a first-order approach of time t would, from F_app = F_c(h_bar) +
+ * D mu_v (-dh_bar/dt) / h_bar^3 with dh_bar/dt = (h_bar* - h_bar) / t; never
+ * below the wanted force (the steady command), at most F_max. The piston
+ * pressure of that force, as a current, goes to lead_lag. */
+static void lead_film(const wc_model_t *model, float hbar_m, float viscosity_Pa_s, float time_s, wc_inverse_t *inv)
+{
+    const wc_calibration_t *cal = model->cal;
+    if (!(model->film_damping_m4 > 0.0f) || !(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return; }
+    const float target_hbar_m = wc_film_hbar_m(&cal->film, inv->force_N / cal->friction_area_m2);
+    if (!(hbar_m > target_hbar_m)) { return; }  /* at or past the wanted film: the steady force */
+    const float contact_N = cal->friction_area_m2 * wc_film_pressure_Pa(&cal->film, hbar_m);
+    const float squeeze_N = model->film_damping_m4 * viscosity_Pa_s * (hbar_m - target_hbar_m) /
+                            (time_s * hbar_m * hbar_m * hbar_m);  /* h_bar >= the table's minimum: finite */
+    float force_N = contact_N + squeeze_N;
+    if (!(force_N > inv->force_N)) { return; }
+    force_N = (force_N < model->force_max_N) ? force_N : model->force_max_N;
+    (void)wc_vfs_current_mA(cal, wc_piston_pressure_Pa(cal, force_N), &inv->current_mA);  /* within range: F <= F_max */
+}
+
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
 {
     WC_ASSERT((clutch != NULL) && (in != NULL) && (out != NULL));
@@ -111,10 +132,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
+    const bool lead = (in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f);
+    if (lead) { lead_film(model, clutch->film_hbar_m, point.viscosity_Pa_s, in->lag_compensation_time_s, &inv); }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
-    if ((in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f)) {
-        status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv);
-    }
+    if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv); }
     out->current_mA = inv.current_mA;
     out->force_command_N = inv.force_N;
     out->inverse_iterations = inv.iterations;

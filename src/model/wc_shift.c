@@ -220,8 +220,9 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             in.mode = WC_MODE_TORQUE;
             in.torque_request_Nm = request_Nm;
             shift->request_Nm = request_Nm;
-            /* once synchronous the clutch carries the turbine torque's share, not the request */
-            in.carried_torque_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;
+            /* once synchronous the clutch carries what the driveline model says
+             * (the feed-forward at a zero slip rate), not the request */
+            in.carried_torque_Nm = wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, 0.0f);
         }
     }
     (void)wc_clutch_step(clutch, &in, out);
@@ -235,7 +236,11 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         const bool in_band = (clutch_cal != NULL) && (fabsf(slip_rad_s) < clutch_cal->lock_slip_rad_s);
         shift->band_periods = in_band ? (shift->band_periods + 1u) : 0u;  /* bounded: the phase times out */
         const bool synchronous = (clutch_cal != NULL) && (shift->band_periods >= clutch_cal->lock_dwell_periods);
-        if (locked || synchronous) {
+        /* the reference has ended: the last slip (the clutch's torque falls with
+         * it, and its static capacity is below the kinetic torque there) is
+         * pulled in by the hand-over's force, not left to the integral */
+        const bool reference_ended = elapsed_s >= shift->target_time_s;
+        if (locked || synchronous || reference_ended) {
             shift->report.inertia_time_s = elapsed_s;
             shift->phase_start_request_Nm = shift->request_Nm;
             enter(shift, WC_SHIFT_LOCKUP);
@@ -244,10 +249,13 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             abort_shift(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
         }
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
-        /* locked once the ramp is done (the lock-up's dwell may end after it): within a second ramp time */
+        /* locked once the ramp is done (the lock-up's dwell and the film may end
+         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times */
         const uint32_t ramp = periods_of(cal->lockup_ramp_time_s, dt_s);
         if (locked && (shift->phase_periods + 1u >= ramp)) { enter(shift, WC_SHIFT_LOCKED); }
-        else if (shift->phase_periods + 1u >= 2u * ramp + 1u) { abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED); }
+        else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
+            abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
+        }
     }
 
     /* Quality vector over the shift (command to its end). */

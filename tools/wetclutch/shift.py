@@ -20,7 +20,10 @@ without the lag compensation) for the pressure-tracking figure.
 
 Quality per shift, from the plant's truth (DESIGN 10):
   inertia_time_s   from the controller's inertia-phase start (the command +
-                   prepare + torque-phase time) to the on-coming clutch's lock;
+                   prepare + torque-phase time) to synchronisation: the true
+                   slip inside SYNC_BAND_RAD_S (the TCU's lock band, 2.9 rpm)
+                   for the first time (the plates lock there, or within the
+                   lock-up hand-over that follows);
   slip_rmse_rpm    RMS(true slip - reference slip) over the inertia phase
                    (the reference is the controller's: a smoothstep from the
                    measured slip at the phase start to 0 in the target time);
@@ -61,6 +64,7 @@ TCU_CALIBRATION = "bench_identified"     # the TCU's clutch model: identified fr
 CONTROLLERS = {"a": "feedback", "b": "blind", "c": "full"}
 TARGET_INERTIA_S = 0.5
 FLARE_RPM = 20.0
+SYNC_BAND_RAD_S = 0.3            # the clutch calibration's lock_slip: synchronised
 TIE_UP_FRACTION = 0.1
 JERK_CUTOFF_HZ = 10.0
 SOAK_SHIFTS = 10
@@ -332,11 +336,11 @@ def quality(rec: dict, target_s: float = TARGET_INERTIA_S) -> dict:
     """The quality vector of one shift from the plant's truth (module docstring)."""
     dt = rec["t_s"][1] - rec["t_s"][0]
     k0, ki = rec["command_step"], rec["inertia_step"]
-    locked = rec["true_oncoming_locked"] > 0.5
-    lock_idx = np.flatnonzero(locked[ki:])
-    k_lock = ki + int(lock_idx[0]) if lock_idx.size else None
-    inertia = (k_lock - ki) * dt if k_lock is not None else float("nan")
-    k_end = k_lock if k_lock is not None else len(locked)
+    sync = (np.abs(rec["true_slip_rad_s"]) < SYNC_BAND_RAD_S) | (rec["true_oncoming_locked"] > 0.5)
+    sync_idx = np.flatnonzero(sync[ki:])
+    k_sync = ki + int(sync_idx[0]) if sync_idx.size else None
+    inertia = (k_sync - ki) * dt if k_sync is not None else float("nan")
+    k_end = k_sync if k_sync is not None else len(sync)
     err = rec["true_slip_rad_s"][ki:k_end] - rec["reference_slip_rad_s"][ki:k_end]
     accel = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
     jerk = np.gradient(accel, dt)
