@@ -18,11 +18,12 @@
  *             (smoothstep); request = feed-forward + PI(slip - reference).
  *             Ends when the slip has stayed inside the clutch's lock band
  *             (lock_slip_rad_s) for lock_dwell_periods, the model locks, or
- *             the reference has ended (target time elapsed).
+ *             the reference has ended (target time elapsed) with the slip
+ *             within min_start_slip_rad_s.
  *   LOCKUP    hand-over: the request ramps to holding_torque_factor * T_t / a
  *             in lockup_ramp_time_s, so that the static capacity exceeds the
- *             torque the clutch carries (T_t / a, passed to the lock-up as
- *             carried_torque_Nm) and the model locks (wc_lockup, DESIGN 9);
+ *             torque the clutch carries (the feed-forward at a zero slip rate,
+ *             passed to the lock-up as carried_torque_Nm) and the model locks (wc_lockup, DESIGN 9);
  *             LOCKED once locked and the ramp done; not locked after
  *             WC_SHIFT_LOCKUP_WAIT ramp times: abort.
  *   LOCKED    shift complete; the holding request stays until the command ends
@@ -82,7 +83,8 @@ typedef struct {
     float inertia_timeout_factor;      /* abort when the inertia phase exceeds target * this (> 1) */
     float lockup_ramp_time_s;          /* hand-over to the holding torque */
     float holding_torque_factor;       /* holding request / (T_t / a), >= 1 */
-    float min_start_slip_rad_s;        /* slip at inertia start must exceed it */
+    float min_start_slip_rad_s;        /* slip at inertia start must exceed it; at the reference's end
+                                        * a slip within it is pulled in by the hand-over */
     /* 2-DOF control */
     float feedforward_gain;            /* 1: the driveline feed-forward; 0: feedback only (comparison) */
     float kp_Nm_per_rad_s;             /* PI on the slip error (slip - reference) */

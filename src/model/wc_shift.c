@@ -236,10 +236,12 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         const bool in_band = (clutch_cal != NULL) && (fabsf(slip_rad_s) < clutch_cal->lock_slip_rad_s);
         shift->band_periods = in_band ? (shift->band_periods + 1u) : 0u;  /* bounded: the phase times out */
         const bool synchronous = (clutch_cal != NULL) && (shift->band_periods >= clutch_cal->lock_dwell_periods);
-        /* the reference has ended: the last slip (the clutch's torque falls with
-         * it, and its static capacity is below the kinetic torque there) is
-         * pulled in by the hand-over's force, not left to the integral */
-        const bool reference_ended = elapsed_s >= shift->target_time_s;
+        /* the reference has ended near synchronism: the last slip (the clutch's
+         * torque falls with it, and its static capacity is below the kinetic
+         * torque there) is pulled in by the hand-over's force, not left to the
+         * integral; far from it the inertia phase goes on (and may time out) */
+        const bool reference_ended = (elapsed_s >= shift->target_time_s) &&
+                                     (fabsf(slip_rad_s) <= cal->min_start_slip_rad_s);
         if (locked || synchronous || reference_ended) {
             shift->report.inertia_time_s = elapsed_s;
             shift->phase_start_request_Nm = shift->request_Nm;
