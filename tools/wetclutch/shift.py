@@ -397,6 +397,29 @@ JERK_LIMIT_M_S3 = 10.0           # (c) peak jerk in the nominal scenario (comfor
 PRESSURE_RATIO_TARGET = 3.0      # pressure tracking RMSE without / with the lag compensation
 
 
+FEEDBACK_KP = (1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 16.0, 24.0, 32.0, 48.0, 64.0)
+FEEDBACK_KI = (10.0, 20.0, 40.0, 80.0, 160.0, 320.0, 640.0)
+
+
+def tune_feedback(plant_path=plant_mod.DEFAULT_PLANT, kps=FEEDBACK_KP, kis=FEEDBACK_KI) -> dict:
+    """The fair tuning of (a): every (kp, ki) of the grid on the nominal scenario; the best is the lowest slip
+    RMSE among the shifts that complete without flare or tie-up. Returns {"grid": [...], "best": {...}}."""
+    params = plant_mod.load_plant(plant_path)
+    cal = shift_calibration.load(SHIFT_TOML).variants["feedback"]
+    nominal = next(s for s in scenario_matrix() if s.name == NOMINAL)
+    grid = []
+    for kp in kps:
+        for ki in kis:
+            q = quality(run_case(params, "shift_1_2_feedback", nominal, shift_cal=cal,
+                                 overrides={"kp_Nm_per_rad_s": kp, "ki_Nm_per_rad": ki})[0])
+            grid.append({"kp": kp, "ki": ki, **{k: q[k] for k in ("slip_rmse_rpm", "peak_jerk_m_s3",
+                                                                   "inertia_time_error", "flare", "tie_up", "abort")}})
+    fair = [g for g in grid if g["abort"] == 0 and not g["flare"] and not g["tie_up"]]
+    best = min(fair or grid, key=lambda g: g["slip_rmse_rpm"])
+    return {"grid": grid, "best": best, "criterion": "lowest slip RMSE on the nominal scenario, no flare, tie-up or abort"
+            + ("" if fair else " (none qualified: lowest slip RMSE overall)")}
+
+
 def run_matrix(plant_path=plant_mod.DEFAULT_PLANT, controllers=("feedback", "blind", "full"),
                scenarios=None, keep_records=("oil80", "oil20", "soak")) -> dict:
     """Every controller on every scenario (in-process); returns {"cases": {controller: {scenario: quality}},
