@@ -12,7 +12,10 @@
  *           (the physical encoders write them); bits 4-5 start temperature
  *           (40, -40, 250 degC or NaN); bit 6 a fuzzed loop configuration
  *           (timeouts, E2E MaxDeltaCounter/SyncCounter, recovery) follows in
- *           bytes 1-5, else WC_LOOP_CONFIG_DEFAULT.
+ *           bytes 1-5, else WC_LOOP_CONFIG_DEFAULT; bit 7 shift control on
+ *           (config.shift = shift_1_2 full; bench input off, and the
+ *           BenchMeasurement choice of the frame id below is ShiftCommand,
+ *           E2E-valid and plausible like the other control frames, Mode 0..3).
  *   then records until the bytes run out (at most MAX_RECORDS), each a
  *   command byte c:
  *     c & 3 == 0  a timer tick without a frame
@@ -40,8 +43,10 @@
  *    ends only after both inputs were fresh for recovery_periods steps in a
  *    row; in the safe state the current is the calibration's minimum;
  *    StatusBenchInput only with bench input enabled;
+ *  - with shift control a step may add a third frame, ShiftReport (0x122),
+ *    which decodes (SNA-free, saturated at most);
  *  - counters: frames_used + sum(rejected) + frames still queued ==
- *    frames_in; frames_out == 2 steps.
+ *    frames_in; frames_out == the frames the steps returned.
  * At the end one more tick empties the ring and the counters must add up
  * with nothing queued. */
 #include <stdio.h>
@@ -53,6 +58,7 @@
 #include <wetclutch_can/wc_loop.h>
 
 #include "wc_fuzz_common.h"
+#include "wc_shift_1_2_shift.h"
 #include "wc_table1_calibration.h"
 
 #define MAX_RECORDS 4096u
@@ -78,6 +84,9 @@ typedef struct {
     wc_loop_config_t config;
     uint8_t alive_sensors;   /* next alive counter of each E2E frame ("make valid") */
     uint8_t alive_request;
+    uint8_t alive_shift;
+    bool shift;              /* shift control on */
+    uint32_t frames_out;     /* frames the steps returned */
     bool have_tx;            /* a VfsCommand was seen: its counter must count */
     uint8_t tx_alive;
     uint32_t fresh_run;      /* consecutive steps without a timeout bit */
@@ -101,6 +110,7 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     const uint8_t sel = (uint8_t)((c >> 3) & 7u);
     memset(f, 0, sizeof *f);
     f->id = (sel < 7u) ? ids[sel] : (uint32_t)fz_u16(r);
+    if ((sel == 6u) && h->shift) { f->id = WC_CAN_SHIFT_COMMAND_FRAME_ID; }
     const uint8_t format = fz_u8(r);
     if ((format & 0x80u) != 0u) {
         f->dlc = (uint8_t)(format & 0x0Fu);
@@ -114,14 +124,21 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     const bool sensors = (f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID);
     const bool request = (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID);
     const bool bench = (f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
-    if (h->plausible && (fault != 3u) && (sensors || request || bench)) {
+    const bool shift = h->shift && (f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID);
+    if (h->plausible && (fault != 3u) && shift) {
+        const wc_can_shift_command_phys_t s = {
+            (float)(fz_u8(r) & 1u), (float)(fz_u8(r) % 8u + 1u), map_u16(fz_u16(r), -1000.0f, 1000.0f),
+            map_u16(fz_u16(r), 50.0f, 2000.0f), 0u };
+        (void)wc_can_encode_shift_command(f->data, &s, sizeof f->data);
+    } else if (h->plausible && (fault != 3u) && (sensors || request || bench)) {
         if (sensors) {
             const wc_can_clutch_sensors_phys_t s = {
                 map_u16(fz_u16(r), -8000.0f, 8000.0f), map_u16(fz_u16(r), -40.0f, 200.0f),
                 map_u16(fz_u16(r), -40.0f, 200.0f), 0u };
             (void)wc_can_encode_clutch_sensors(f->data, &s, sizeof f->data);
         } else if (request) {
-            const wc_can_torque_request_phys_t q = { map_u16(fz_u16(r), 0.0f, 2000.0f), (uint8_t)(fz_u8(r) % 3u), 0u };
+            const wc_can_torque_request_phys_t q = { map_u16(fz_u16(r), 0.0f, 2000.0f),
+                                                     (uint8_t)(fz_u8(r) % (h->shift ? 4u : 3u)), 0u };
             (void)wc_can_encode_torque_request(f->data, &q, sizeof f->data);
         } else {
             const wc_can_bench_measurement_phys_t b = {
@@ -132,8 +149,8 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     } else {
         for (size_t i = 0u; i < sizeof f->data; ++i) { f->data[i] = fz_u8(r); }
     }
-    if (!h->make_valid || !(sensors || request) || (fault == 3u)) { return; }
-    uint8_t *alive = sensors ? &h->alive_sensors : &h->alive_request;
+    if (!h->make_valid || !(sensors || request || shift) || (fault == 3u)) { return; }
+    uint8_t *alive = sensors ? &h->alive_sensors : (request ? &h->alive_request : &h->alive_shift);
     if (fault == 1u) {  /* counter = previous + delta: 0 repeats, 2 loses one frame, ... */
         const uint8_t delta = (uint8_t)(fz_u8(r) & WC_E2E_COUNTER_MASK);
         *alive = (uint8_t)((*alive + delta + 15u) % 16u);
@@ -158,7 +175,7 @@ static void check_counters(const harness_t *h)
     FZ_CHECK(loop.counters.frames_used + rejected_sum(&loop) + queued == loop.counters.frames_in,
              "counters: used %u + rejected %u + queued %u != in %u", (unsigned)loop.counters.frames_used,
              (unsigned)rejected_sum(&loop), (unsigned)queued, (unsigned)loop.counters.frames_in);
-    FZ_CHECK((loop.counters.steps == h->steps) && (loop.counters.frames_out == 2u * h->steps),
+    FZ_CHECK((loop.counters.steps == h->steps) && (loop.counters.frames_out == h->frames_out),
              "steps %u (harness %u), frames out %u", (unsigned)loop.counters.steps, (unsigned)h->steps,
              (unsigned)loop.counters.frames_out);
 }
@@ -247,9 +264,18 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
     const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
                                    (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
-    FZ_CHECK(n == (expected ? WC_LOOP_TX_CYCLIC : 0u), "wc_loop_iterate returned %u, expected %u", (unsigned)n,
-             expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u);
-    if (n == WC_LOOP_TX_CYCLIC) {
+    const bool report = h->shift && (n == WC_LOOP_TX_FRAMES);
+    FZ_CHECK(n == (expected ? (report ? WC_LOOP_TX_FRAMES : WC_LOOP_TX_CYCLIC) : 0u),
+             "wc_loop_iterate returned %u, expected %u", (unsigned)n, expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u);
+    if (report) {
+        FZ_CHECK((out[2].id == WC_CAN_SHIFT_REPORT_FRAME_ID) && (out[2].dlc == 8u) && (out[2].flags == 0u),
+                 "third frame id 0x%x dlc %u", (unsigned)out[2].id, (unsigned)out[2].dlc);
+        wc_can_shift_report_phys_t q;
+        const wc_can_result_t rq = wc_can_decode_shift_report(&q, out[2].data, out[2].dlc);
+        FZ_CHECK(!wc_can_is_error(rq), "ShiftReport does not decode cleanly (result %d)", (int)rq);
+    }
+    h->frames_out += n;
+    if (n >= WC_LOOP_TX_CYCLIC) {
         check_step(h, out);
     } else {
         check_counters(h);
@@ -277,7 +303,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         h.config.e2e.sync_counter = fz_u8(&r) % 8u;
         h.config.recovery_periods = fz_u8(&r) % 64u;
     }
-    h.config.bench_input_enabled = (options & 0x02u) != 0u;
+    h.shift = (options & 0x80u) != 0u;
+    h.config.bench_input_enabled = ((options & 0x02u) != 0u) && !h.shift;
+    h.config.shift = h.shift ? &wc_shift_1_2_full : NULL;
 
     fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
     fz_arg(theta_start);
