@@ -1245,7 +1245,7 @@ static void test_loop_init_invalid_shift_calibration(void **state)
     (void)state;
     static wc_loop_t loop;
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
-    wc_shift_calibration_t cal = test_cal;
+    wc_shift_calibration_t cal;
     for (size_t i = 0u; i < WC_TEST_COUNT(shift_fields); ++i) {
         cal = test_cal;
         *shift_field_ptr(&cal, shift_fields[i].offset) = NAN;
