@@ -254,6 +254,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
                                     "theta_estimate_degC", "model_torque_Nm", "locked_tcu")}
     truth = {}
     frames_out = []
+    frames_in = []          # what the TCU received, for the reference (shift_reference.py)
     report = None
     current = 0.0
     for k in range(n):
@@ -265,6 +266,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
                             TargetInertiaTime=round(target_s * 1e3)),
                   enc.frame(canlog.SENSORS, SlipSpeed=float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
                             OilTemp=float(s["oil_degC"]), HousingTemp=float(s["housing_degC"]))]
+        frames_in.append([(m.arbitration_id, bytes(m.data)) for m in frames])
         out = tcu.exchange(t, frames)
         for fid, data in out:
             frames_out.append((k, fid, data.hex().upper()))
@@ -288,6 +290,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
             truth.setdefault(name, np.empty(n))[k] = v
     rec.update({f"true_{k}": v for k, v in truth.items()})
     rec["frames"] = frames_out
+    rec["frames_in"] = frames_in
     rec["report"] = report
     rec["command_step"] = n_pre
     n_prep = int(shift_cal.prepare_time / dt + 0.5)
@@ -324,6 +327,39 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
     finally:
         if own:
             tcu.close()
+
+
+def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float) -> dict:
+    """The double-precision reference (shift_reference.py) on the inputs the TCU received in rec, with the
+    TCU's safe state from its VfsCommand: per step the reference's current and the TCU's (decoded), and the
+    reports of both."""
+    from . import shift_reference
+    db = canlog.database()
+    msgs = {n: db.get_message_by_name(n) for n in (canlog.SENSORS, canlog.SHIFT_COMMAND, canlog.COMMAND,
+                                                   canlog.SHIFT_REPORT)}
+    ids = {m.frame_id: n for n, m in msgs.items()}
+    ref = shift_reference.ShiftReference(shift_cal, clutch_cal, theta_start_degC)
+    n = len(rec["frames_in"])
+    out = {"reference_mA": np.empty(n), "tcu_mA": np.empty(n), "reference_report": None, "tcu_report": None,
+           "reference_report_step": None, "tcu_report_step": None}
+    outputs = {}
+    for k, fid, data in rec["frames"]:
+        outputs.setdefault(k, []).append((fid, bytes.fromhex(data)))
+    for k, frames in enumerate(rec["frames_in"]):
+        got = {ids[fid]: msgs[ids[fid]].decode(data, decode_choices=False) for fid, data in frames if fid in ids}
+        c, s = got[canlog.SHIFT_COMMAND], got[canlog.SENSORS]
+        tcu = {ids[fid]: msgs[ids[fid]].decode(data, decode_choices=False) for fid, data in outputs.get(k, []) if fid in ids}
+        vfs = tcu[canlog.COMMAND]
+        step_out, report = ref.step(bool(c["ShiftRequest"]), int(c["TargetGear"]), float(c["TurbineTorque"]),
+                                    float(c["TargetInertiaTime"]) * 1e-3, bool(vfs["StatusSafeStateActive"]),
+                                    float(s["SlipSpeed"]), float(s["OilTemp"]), float(s["HousingTemp"]))
+        out["reference_mA"][k] = step_out["current_mA"]
+        out["tcu_mA"][k] = float(vfs["VfsCurrent"])
+        if report is not None and out["reference_report"] is None:
+            out["reference_report"], out["reference_report_step"] = report, k
+        if canlog.SHIFT_REPORT in tcu and out["tcu_report"] is None:
+            out["tcu_report"], out["tcu_report_step"] = tcu[canlog.SHIFT_REPORT], k
+    return out
 
 
 def _lowpass_zero_phase(x: np.ndarray, dt: float, cutoff_hz: float) -> np.ndarray:

@@ -30,7 +30,7 @@ class ShiftCalibrationError(Exception):
 TIME_MAX_S = 10.0
 INERTIA_TIME_MIN_S, INERTIA_TIME_MAX_S = 0.05, 5.0
 GAIN_MAX = 1e5
-TORQUE_MAX_NM = 5000.0     # WC_TORQUE_MAX_Nm
+TORQUE_MAX_NM = 1.0e5      # WC_TORQUE_MAX_Nm
 SLIP_MAX_RAD_S = 1047.2    # WC_SLIP_MAX_rad_s
 
 # (name in the file, unit, C field, check) in the C struct's order. check(value, values) -> bool.
