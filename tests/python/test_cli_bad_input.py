@@ -140,6 +140,7 @@ COMMANDS = {
                                                                    "--out", out, "--jobs", "1", "--no-plots"]),
     "identify-true": (".toml", "toml", lambda bad, out, g: ["identify", "mu", g["campaign"], "--true", bad,
                                                             "--out", out, "--jobs", "1", "--no-plots"]),
+    "shift-plant": (".toml", "toml", lambda bad, out, g: ["shift", "--plant", bad, "--out", out]),
 }
 KINDS = ("junk", "empty", "nan", "inf", "missing", "directory")
 CASES = [(c, k) for c in COMMANDS for k in KINDS if not (COMMANDS[c][1] is None and k in ("nan", "inf"))]

@@ -173,7 +173,12 @@ def _cmd_film_study(args) -> int:
 
 
 def _cmd_shift(args) -> int:
-    from . import shift  # the plant and the closed loop only when needed
+    from . import plant, shift  # the plant and the closed loop only when needed
+    try:
+        plant.load_plant(args.plant)    # a bad plant file: one line naming it, before any work
+    except plant.PlantError as e:
+        print(f"wetclutch shift: {e}", file=sys.stderr)
+        return 2
     if args.tune_feedback:
         res = shift.tune_feedback(args.plant)
         for g in res["grid"]:

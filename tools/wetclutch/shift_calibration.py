@@ -122,6 +122,8 @@ def load(path: str | Path) -> ShiftCalibrationSet:
         raise ShiftCalibrationError(f"{path}: cannot read: {e.strerror or e}") from None
     except tomllib.TOMLDecodeError as e:
         raise ShiftCalibrationError(f"{path}: not valid TOML: {e}") from None
+    except UnicodeDecodeError:
+        raise ShiftCalibrationError(f"{path}: not UTF-8 text: not a TOML file") from None
     base = doc.get("shift")
     if not isinstance(base, dict):
         raise ShiftCalibrationError(f"{path}: no [shift] table")
@@ -195,5 +197,5 @@ def is_shift_calibration(path: str | Path) -> bool:
     try:
         with open(path, "rb") as f:
             return isinstance(tomllib.load(f).get("shift"), dict)
-    except (OSError, tomllib.TOMLDecodeError):
-        return False
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+        return False   # not one: the clutch calibration's loader reports what is wrong with the file
