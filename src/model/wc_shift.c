@@ -200,8 +200,13 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
-        start(shift, command, slip_rad_s);
-        if (!command_valid(cal, command)) { abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND); }
+        if (command_valid(cal, command)) {
+            start(shift, command, slip_rad_s);
+        } else {  /* nothing of the command is kept (it may hold NaN) */
+            wc_shift_init(shift);
+            shift->last_request = true;
+            abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
+        }
     }
     if (running(shift->phase) && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */

@@ -118,12 +118,13 @@ class ShiftReference:
         elif edge and self.phase == IDLE:
             self._reset()
             self.last_request = True
-            self.turbine_torque, self.target_s, self.start_slip = turbine_torque_Nm, target_inertia_s, slip
-            self.report["peak_theta_degC"] = model.THETA_MIN_DEGC
-            self._enter(PREPARE)
             valid = (target_gear == 2 and v["inertia_time_min"] <= target_inertia_s <= v["inertia_time_max"]
                      and 0.0 <= turbine_torque_Nm <= model.TORQUE_MAX_NM)
-            if not valid:
+            if valid:
+                self.turbine_torque, self.target_s, self.start_slip = turbine_torque_Nm, target_inertia_s, slip
+                self.report["peak_theta_degC"] = model.THETA_MIN_DEGC
+                self._enter(PREPARE)
+            else:
                 self._abort(ABORT_INVALID_COMMAND)
         if self.phase in RUNNING and 0.0 <= turbine_torque_Nm <= model.TORQUE_MAX_NM:
             self.turbine_torque = turbine_torque_Nm
