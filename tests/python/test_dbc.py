@@ -33,8 +33,10 @@ GENERATED_FILES = ("include/wetclutch_can/wc_can.h", "src/can/generated/wc_can.c
 FRAMES = {
     "ClutchSensors": (0x110, "BENCH", {"TCU"}, 1, True),
     "TorqueRequest": (0x111, "VCU", {"TCU"}, 1, True),
+    "ShiftCommand": (0x112, "VCU", {"TCU"}, 1, True),
     "VfsCommand": (0x120, "TCU", {"BENCH"}, 1, True),
     "ClutchEstimate": (0x121, "TCU", {"BENCH"}, 1, False),
+    "ShiftReport": (0x122, "TCU", {"VCU"}, None, False),   # sent once per shift, not cyclic
     "BenchMeasurement": (0x130, "BENCH", {"TCU"}, 1, False),
 }
 # Layout constants of src/can/wc_e2e.h.
@@ -49,7 +51,7 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
     "StatusFrameLost", "StatusBusError", "StatusLocked",
 ]
 # Integer signals that the scaling wrapper does not convert.
-UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", *STATUS_BITS}
+UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", *STATUS_BITS}
 
 
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
@@ -159,8 +161,8 @@ def test_ranges_fit_and_sna_is_reserved(db):
 def test_mode_values(db):
     mode = db.get_message_by_name("TorqueRequest").get_signal_by_name("Mode")
     assert {k: str(v) for k, v in mode.choices.items()} == {
-        0: "Open", 1: "TorqueControl", 2: "Locked"}
-    assert (mode.minimum, mode.maximum) == (0, 2)
+        0: "Open", 1: "TorqueControl", 2: "Locked", 3: "Shift"}
+    assert (mode.minimum, mode.maximum) == (0, 3)
 
 
 def test_crc8_vectors():
@@ -211,6 +213,10 @@ static const struct { const char *name; const wc_can_signal_t *sig; } sigs[] = {
     SIG(clutch_estimate, mu_f), SIG(clutch_estimate, film_thickness),
     SIG(bench_measurement, load_cell_force), SIG(bench_measurement, measured_torque),
     SIG(bench_measurement, clutch_thermistor_temp),
+    SIG(shift_command, shift_request), SIG(shift_command, target_gear), SIG(shift_command, turbine_torque),
+    SIG(shift_command, target_inertia_time), SIG(shift_report, inertia_phase_time), SIG(shift_report, slip_rmse),
+    SIG(shift_report, peak_jerk), SIG(shift_report, friction_energy), SIG(shift_report, peak_clutch_temp),
+    SIG(shift_report, flare), SIG(shift_report, tie_up),
 };
 
 static float F(const char *s) { return strtof(s, NULL); }
