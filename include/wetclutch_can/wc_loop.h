@@ -170,8 +170,10 @@ void wc_loop_port_event(wc_loop_t *loop, wc_loop_port_event_t event, uint32_t co
  * a third control input (E2E, timeout request_timeout_periods, counted as a
  * request timeout: StatusRequestTimeout) and the safe state applies to it
  * like to the others; a shift running when the safe state begins aborts
- * (released, ShiftReport AbortReason 3). Without config.shift, Mode 3 is
- * implausible and ShiftCommand an unknown id. */
+ * (released, ShiftReport AbortReason 3). Leaving Shift mode ends a finished
+ * shift at once (the new mode acts in that very period) and aborts a running
+ * one (AbortReason 4, released). Without config.shift, Mode 3 is implausible
+ * and ShiftCommand an unknown id. */
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* When a port's main loop steps the model. */

@@ -1203,6 +1203,29 @@ static void test_loop_safe_state_after_shift_releases(void **state)
              (double)l.vfs.vfs_current_mA, (unsigned)l.loop.shift.phase);
 }
 
+/* After a completed shift the VCU hands the clutch back (Mode 2, Locked):
+ * the very first period in the new mode commands it (maximum current), with
+ * no period of the shift controller's released output in between (a 1 ms dip
+ * to the minimum current on the solenoid). */
+static void test_loop_leaving_shift_mode_after_the_shift_has_no_dip(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    loop_start(&l, &test_cal);
+    for (int k = 0; (k < 2000) && (l.loop.shift.phase != (uint32_t)WC_SHIFT_LOCKED); ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+    }
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_LOCKED);
+    const float max_mA = wc_table1_calibration.vfs_current_max_mA;
+    for (int k = 0; k < 20; ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE, 0);
+        WC_CHECK(fabsf(l.vfs.vfs_current_mA - max_mA) <= 0.5f, "period %d in Locked mode: %g mA, not the maximum %g",
+                 k, (double)l.vfs.vfs_current_mA, (double)max_mA);
+        assert_int_equal(l.n, WC_LOOP_TX_CYCLIC);  /* no second report */
+    }
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_IDLE);
+}
+
 static void test_loop_mode3_without_shift(void **state)
 {
     (void)state;
@@ -1292,6 +1315,7 @@ int main(void)
         cmocka_unit_test(test_loop_shift_report),
         cmocka_unit_test(test_loop_shift_command_stale),
         cmocka_unit_test(test_loop_safe_state_after_shift_releases),
+        cmocka_unit_test(test_loop_leaving_shift_mode_after_the_shift_has_no_dip),
         cmocka_unit_test(test_loop_mode3_without_shift),
         cmocka_unit_test(test_loop_init_invalid_shift_calibration),
     };
