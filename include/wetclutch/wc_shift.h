@@ -181,6 +181,12 @@ typedef struct {
 
 void wc_shift_init(wc_shift_t *shift);
 
+/* A shift in progress (PREPARE .. LOCKUP): it owns the clutch until it ends. */
+static inline bool wc_shift_phase_running(uint32_t phase)
+{
+    return (phase >= (uint32_t)WC_SHIFT_PREPARE) && (phase <= (uint32_t)WC_SHIFT_LOCKUP);
+}
+
 /* The reference slip of the inertia phase (DESIGN 10) at elapsed_s after its
  * start: start_slip * (1 - s(x)), s(x) = 3x^2 - 2x^3, x = elapsed / target
  * clamped to [0, 1]; *rate_rad_s2 its time derivative (0 at both ends). */

@@ -331,11 +331,9 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         .bench = { bench_fresh, (load_cell_N > 0.0f) ? load_cell_N : 0.0f, loop->bench.measured_torque_Nm },
     };
     bool report = false;
-    const uint32_t phase = loop->shift.phase;
-    const bool shift_running = (phase >= (uint32_t)WC_SHIFT_PREPARE) && (phase <= (uint32_t)WC_SHIFT_LOCKUP);
-    if (!shift_mode && !shift_running) {
-        loop->shift.phase = (uint32_t)WC_SHIFT_IDLE;  /* a finished shift ends with its mode: the new mode acts now */
-        loop->shift.last_request = false;
+    const bool shift_running = wc_shift_phase_running(loop->shift.phase);
+    if (!shift_mode && !shift_running && (loop->shift.phase != (uint32_t)WC_SHIFT_IDLE)) {
+        wc_shift_init(&loop->shift);  /* a finished shift ends with its mode: the new mode acts now */
     }
     if ((loop->config.shift != NULL) && (shift_mode || shift_running)) {
         /* the shift controller owns the clutch; leaving Shift mode mid-shift withdraws the command (abort) */

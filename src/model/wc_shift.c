@@ -84,11 +84,6 @@ static uint32_t periods_of(float time_s, float dt_s)
     return (uint32_t)n;
 }
 
-static bool running(uint32_t phase)
-{
-    return (phase == (uint32_t)WC_SHIFT_PREPARE) || (phase == (uint32_t)WC_SHIFT_TORQUE) ||
-           (phase == (uint32_t)WC_SHIFT_INERTIA) || (phase == (uint32_t)WC_SHIFT_LOCKUP);
-}
 
 static void enter(wc_shift_t *shift, wc_shift_phase_t phase)
 {
@@ -194,7 +189,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
 
     /* Transitions on the command and the loop's state. */
     if (safe || !command->request) {
-        if (running(shift->phase)) {
+        if (wc_shift_phase_running(shift->phase)) {
             abort_shift(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
         } else if (!command->request || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
             enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
@@ -208,7 +203,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
         }
     }
-    if (running(shift->phase) && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+    if (wc_shift_phase_running(shift->phase) && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
 
@@ -218,7 +213,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     in.carried_torque_Nm = 0.0f;
     in.lag_compensation_time_s = cal->lag_compensation_time_s;
     in.theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
-    if (running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
+    if (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
         float request_Nm = phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated);
         request_Nm = (request_Nm > 0.0f) ? ((request_Nm < WC_TORQUE_MAX_Nm) ? request_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
@@ -266,14 +261,14 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     }
 
     /* Quality vector over the shift (command to its end). */
-    if (running(phase_before) || running(shift->phase)) {
+    if (wc_shift_phase_running(phase_before) || wc_shift_phase_running(shift->phase)) {
         wc_shift_report_t *q = &shift->report;
         q->friction_energy_J += fabsf(out->model.torque_Nm * slip_rad_s) * dt_s;  /* eq. 1's heat input */
         if (clutch->theta_degC > q->peak_theta_degC) { q->peak_theta_degC = clutch->theta_degC; }
         const float alpha = dt_s / (cal->jerk_filter_time_s + dt_s);  /* first-order filter, exact for tau = 0 */
         const float filtered = shift->filtered_torque_Nm + (out->model.torque_Nm - shift->filtered_torque_Nm) * alpha;
         const float jerk = fabsf(cal->jerk_per_torque_rate * (filtered - shift->filtered_torque_Nm) / dt_s);
-        if (running(phase_before) && (jerk > q->peak_jerk_m_s3)) { q->peak_jerk_m_s3 = jerk; }  /* not the first sample */
+        if (wc_shift_phase_running(phase_before) && (jerk > q->peak_jerk_m_s3)) { q->peak_jerk_m_s3 = jerk; }  /* not the first sample */
         shift->filtered_torque_Nm = filtered;
     }
     if (shift->phase == phase_stepped) {  /* a phase entered after the step starts counting at the next */

@@ -497,7 +497,6 @@ def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float) -> di
 CLUTCH_OUTPUTS = ("current_mA", "pressure_command_Pa", "pressure_model_Pa", "force_command_N", "theta_degC",
                   "torque_Nm", "mu_f", "hbar_m", "contact_force_N", "static_capacity_Nm", "status")
 LEAD_TIME_MAX_S = 10.0   # WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s: a longer lag-compensation time counts as off
-CARRIED_MAX_NM = TORQUE_MAX_NM  # WC_TORQUE_MAX_Nm: a carried torque above it counts as not given
 
 
 class ClutchReference:
@@ -596,7 +595,7 @@ class ClutchReference:
         torque = float(parts["torque_Nm"]) * (lockup.direction if in_band else (-1.0 if slip_rpm < 0.0 else 1.0))
         capacity = float(static_capacity_Nm(cal, theta_model, contact))
         bench_torque = not math.isnan(bench_torque_Nm)
-        carried = 0.0 < carried_torque_Nm <= CARRIED_MAX_NM
+        carried = 0.0 < carried_torque_Nm <= TORQUE_MAX_NM   # else the request (wc_clutch_step)
         required = bench_torque_Nm if bench_torque else lockup.direction * (carried_torque_Nm if carried else request_Nm)
         slip_rad_s = slip_rpm * RAD_S_PER_RPM
         if lockup.update(slip_rad_s, required, capacity):

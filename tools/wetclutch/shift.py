@@ -54,7 +54,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import canlog, plant as plant_mod, shift_calibration
+from . import canlog, plant as plant_mod, shift_calibration, shift_reference
 from .atomic import Staged
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -230,12 +230,6 @@ def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: s
     return 0
 
 
-def reference_slip(start_rad_s: float, target_s: float, elapsed_s: np.ndarray) -> np.ndarray:
-    """The controller's reference (wc_shift_reference_slip): start (1 - (3x^2 - 2x^3)), x = elapsed / target."""
-    x = np.clip(elapsed_s / target_s, 0.0, 1.0)
-    return start_rad_s * (1.0 - x * x * (3.0 - 2.0 * x))
-
-
 def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s: float, seed: int,
                target_s: float, shift_cal) -> dict:
     """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record."""
@@ -299,7 +293,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["inertia_step"] = k_i
     start = rec["sensor_slip_rad_s"][k_i]
     ref = np.full(n, np.nan)
-    ref[k_i:] = reference_slip(start, target_s, (np.arange(n - k_i)) * dt)
+    ref[k_i:] = [shift_reference.reference_slip(start, target_s, j * dt)[0] for j in range(n - k_i)]
     rec["reference_slip_rad_s"] = ref
     rec["end_theta_degC"] = float(truth["theta_clutch_degC"][-1])
     return rec
@@ -333,7 +327,6 @@ def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float) -> 
     """The double-precision reference (shift_reference.py) on the inputs the TCU received in rec, with the
     TCU's safe state from its VfsCommand: per step the reference's current and the TCU's (decoded), and the
     reports of both."""
-    from . import shift_reference
     db = canlog.database()
     msgs = {n: db.get_message_by_name(n) for n in (canlog.SENSORS, canlog.SHIFT_COMMAND, canlog.COMMAND,
                                                    canlog.SHIFT_REPORT)}
