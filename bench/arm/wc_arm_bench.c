@@ -103,6 +103,7 @@ static const float request_grid[] = {0.0f, 0.05f, 0.3f, 0.6f, 0.9f, 1.1f};
 typedef enum {
     ROW_CLUTCH_STEP = 0,
     ROW_CLUTCH_STEP_FILM,
+    ROW_CLUTCH_STEP_FILM_LAG,
     ROW_INVERSE_SOLVE,
     ROW_INVERSE_BELOW_DRAG,
     ROW_INVERSE_SATURATED,
@@ -121,6 +122,8 @@ typedef enum {
     ROW_CRC8,
     ROW_SHIFT_STEP,
     ROW_LOOP_STEP_SHIFT,
+    ROW_SHIFT_STEP_FILM,
+    ROW_LOOP_STEP_SHIFT_FILM,
     ROWS
 } row_t;
 
@@ -128,6 +131,7 @@ typedef enum {
 static const char *const row_name[ROWS] = {
     [ROW_CLUTCH_STEP] = "wc_clutch_step",
     [ROW_CLUTCH_STEP_FILM] = "wc_clutch_step:film",
+    [ROW_CLUTCH_STEP_FILM_LAG] = "wc_clutch_step:film_lag",
     [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
     [ROW_INVERSE_BELOW_DRAG] = "wc_inverse:below_drag",
     [ROW_INVERSE_SATURATED] = "wc_inverse:saturated",
@@ -146,12 +150,17 @@ static const char *const row_name[ROWS] = {
     [ROW_CRC8] = "wc_e2e_crc8_j1850:8B",
     [ROW_SHIFT_STEP] = "wc_shift_step:inertia",
     [ROW_LOOP_STEP_SHIFT] = "wc_loop_step:shift_inertia",
+    [ROW_SHIFT_STEP_FILM] = "wc_shift_step:inertia_film",
+    [ROW_LOOP_STEP_SHIFT_FILM] = "wc_loop_step:shift_inertia_film",
 };
 
 /* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods. */
 #define SHIFT_SAMPLES_MAX 768u
 /* expf: two arguments per grid point; the shift rows: one per inertia-phase period */
-#define SAMPLES_PER_ROW ((2u * GRID_POINTS > SHIFT_SAMPLES_MAX) ? 2u * GRID_POINTS : SHIFT_SAMPLES_MAX)
+/* wc_clutch_step:film_lag: the steps of FILM_LAG_STEPS per grid point */
+#define FILM_LAG_SAMPLES_PER_POINT 6u
+#define SAMPLES_PER_ROW ((FILM_LAG_SAMPLES_PER_POINT * GRID_POINTS > SHIFT_SAMPLES_MAX) ? \
+                         FILM_LAG_SAMPLES_PER_POINT * GRID_POINTS : SHIFT_SAMPLES_MAX)
 static uint32_t samples[ROWS][SAMPLES_PER_ROW];
 static uint32_t sample_count[ROWS];
 
@@ -399,6 +408,11 @@ typedef struct {
     float fraction;
 } worst_diff_t;
 
+/* The film_lag row's measured steps of a fresh clutch: the first, the lead at
+ * work while the film closes (the film settles in about 0.1 s), and settled. */
+#define FILM_LAG_TIME_s 0.015f
+static const uint32_t film_lag_steps[FILM_LAG_SAMPLES_PER_POINT] = {1u, 4u, 10u, 25u, 60u, 150u};
+
 static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_diff_t *worst)
 {
     const float slip_rad_s = slip_rpm * WC_RAD_S_PER_RPM;
@@ -470,6 +484,25 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
     for (uint32_t k = 0u; k < WARMUP_STEPS; ++k) { thunk_clutch_step(&ctx); }
     record(ROW_CLUTCH_STEP_FILM, measure(thunk_clutch_step, &ctx));
     if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step (film) rejected a grid point"); }
+
+    /* The configuration the shift controller runs the clutch in: the identified
+     * calibration (film on) with the lag compensation of 15 ms (shift_1_2.toml),
+     * a fresh clutch at the open film; the steps of FILM_LAG_STEPS measured, so
+     * that the film's approach (lead active, then settled) is on the grid. */
+    if (wc_clutch_init(&clutch, wc_arm_identified_calibration, theta_degC) != WC_CAL_OK) {
+        fail("wc_clutch_init (identified)");
+    }
+    ctx.step_in.lag_compensation_time_s = FILM_LAG_TIME_s;
+    for (uint32_t k = 1u, next = 0u; next < FILM_LAG_SAMPLES_PER_POINT; ++k) {
+        if (k == film_lag_steps[next]) {
+            record(ROW_CLUTCH_STEP_FILM_LAG, measure(thunk_clutch_step, &ctx));
+            if ((ctx.status & WC_STATUS_INPUT_INVALID) != 0u) { fail("wc_clutch_step (film, lag) rejected a grid point"); }
+            next++;
+        } else {
+            thunk_clutch_step(&ctx);
+        }
+    }
+    ctx.step_in.lag_compensation_time_s = 0.0f;
 
     /* wc_loop_step: both input frames queued every period, the 4th step measured. */
     /* The default configuration with a one-period recovery debounce, so that the
@@ -569,10 +602,10 @@ static void plant_advance(shift_plant_t *p, uint32_t phase, const wc_step_output
 static wc_shift_t shift;
 
 /* wc_shift_step on its own: every step that starts in the inertia phase. */
-static void bench_shift_step(void)
+static void bench_shift_step(const wc_calibration_t *cal, row_t row)
 {
     if ((wc_shift_calibration_check(&shift_calibration) != WC_SHIFT_CAL_OK) ||
-        (wc_clutch_init(&clutch, wc_arm_calibration, SHIFT_OIL_degC) != WC_CAL_OK)) {
+        (wc_clutch_init(&clutch, cal, SHIFT_OIL_degC) != WC_CAL_OK)) {
         fail("shift: calibration");
         return;
     }
@@ -589,7 +622,7 @@ static void bench_shift_step(void)
         ctx.step_in = (wc_step_input_t){.slip_rad_s = plant.slip_rad_s, .theta_oil_degC = SHIFT_OIL_degC,
                                         .theta_housing_degC = SHIFT_OIL_degC};
         if (shift.phase == (uint32_t)WC_SHIFT_INERTIA) {
-            record(ROW_SHIFT_STEP, measure(thunk_shift_step, &ctx));
+            record(row, measure(thunk_shift_step, &ctx));
         } else {
             thunk_shift_step(&ctx);
         }
@@ -635,11 +668,11 @@ static void queue_shift_frames(float slip_rad_s, bool shift_request, uint8_t ali
  * sync, recovery_periods), then 1: a rising edge outside the safe state
  * starts the shift. Every step that starts in the inertia phase is a sample. */
 #define SHIFT_LOOP_SETTLE_PERIODS 40u
-static void bench_loop_shift(void)
+static void bench_loop_shift(const wc_calibration_t *cal, row_t row)
 {
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     config.shift = &shift_calibration;
-    if (wc_loop_init(&loop, wc_arm_calibration, &config, SHIFT_OIL_degC) != WC_CAL_OK) {
+    if (wc_loop_init(&loop, cal, &config, SHIFT_OIL_degC) != WC_CAL_OK) {
         fail("shift: wc_loop_init");
         return;
     }
@@ -655,7 +688,7 @@ static void bench_loop_shift(void)
         alive = wc_e2e_counter_next(alive);
         const uint32_t safe_before = loop.counters.safe_steps;
         if (loop.shift.phase == (uint32_t)WC_SHIFT_INERTIA) {
-            record(ROW_LOOP_STEP_SHIFT, measure(thunk_loop_step, &ctx));
+            record(row, measure(thunk_loop_step, &ctx));
             if (loop.counters.safe_steps != safe_before) { safe_in_shift++; }
         } else {
             thunk_loop_step(&ctx);
@@ -742,8 +775,10 @@ int main(void)
             }
         }
 
-        bench_shift_step();
-        bench_loop_shift();
+        bench_shift_step(wc_arm_calibration, ROW_SHIFT_STEP);
+        bench_loop_shift(wc_arm_calibration, ROW_LOOP_STEP_SHIFT);
+        bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_FILM);
+        bench_loop_shift(wc_arm_identified_calibration, ROW_LOOP_STEP_SHIFT_FILM);
 
         wc_arm_puts("GRID ");
         wc_arm_put_u32((uint32_t)GRID_POINTS);

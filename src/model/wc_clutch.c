@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "wc_film_internal.h"
 #include "wetclutch/wc_film.h"
 #include "wetclutch/wc_hydraulics.h"
 #include "wc_internal.h"
@@ -79,14 +80,15 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ti
  * as a first-order approach of time t would, from F_app = F_c(h_bar) +
  * D mu_v (-dh_bar/dt) / h_bar^3 with dh_bar/dt = (h_bar* - h_bar) / t; never
  * below the wanted force (the steady command), at most F_max. The piston
- * pressure of that force, as a current, goes to lead_lag. */
-static void lead_film(const wc_model_t *model, float hbar_m, float viscosity_Pa_s, float time_s, wc_inverse_t *inv)
+ * pressure of that force, as a current, goes to lead_lag. contact_N is the
+ * asperity force F_c(h_bar) of the film state. */
+static void lead_film(const wc_model_t *model, float hbar_m, float contact_N, float viscosity_Pa_s, float time_s,
+                      wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
     if (!(model->film_damping_m4 > 0.0f) || !(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return; }
     const float target_hbar_m = wc_film_hbar_m(&cal->film, inv->force_N / cal->friction_area_m2);
     if (!(hbar_m > target_hbar_m)) { return; }  /* at or past the wanted film: the steady force */
-    const float contact_N = cal->friction_area_m2 * wc_film_pressure_Pa(&cal->film, hbar_m);
     const float squeeze_N = model->film_damping_m4 * viscosity_Pa_s * (hbar_m - target_hbar_m) /
                             (time_s * hbar_m * hbar_m * hbar_m);  /* h_bar >= the table's minimum: finite */
     float force_N = contact_N + squeeze_N;
@@ -132,8 +134,15 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
+    /* DESIGN 9: the asperity contact of the film state, once per period: the
+     * lead, the torque and the film's advance share it. */
+    const bool film = model->film_damping_m4 > 0.0f;
+    const float hbar_m = clutch->film_hbar_m;
+    wc_film_contact_t contact = { 0.0f, 0.0f };
+    if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
+    const float film_contact_N = model->cal->friction_area_m2 * contact.pressure_Pa;
     const bool lead = (in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f);
-    if (lead) { lead_film(model, clutch->film_hbar_m, point.viscosity_Pa_s, in->lag_compensation_time_s, &inv); }
+    if (lead) { lead_film(model, hbar_m, film_contact_N, point.viscosity_Pa_s, in->lag_compensation_time_s, &inv); }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv); }
     out->current_mA = inv.current_mA;
@@ -158,15 +167,14 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     const float direction = (clutch->lockup.direction < 0) ? -1.0f : 1.0f;
     const float signed_slip_rad_s = (fabsf(u->slip_rad_s) < cal->lock_slip_rad_s) ? direction : u->slip_rad_s;
     /* (the torque takes only its sign from it: the speed is the point's) */
-    if (model->film_damping_m4 > 0.0f) {
+    if (film) {
         /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
          * squeeze film carries the rest, and the film advances under the force. */
-        const float hbar_m = clutch->film_hbar_m;
-        const float contact_N = cal->friction_area_m2 * wc_film_pressure_Pa(&cal->film, hbar_m);
-        wc_torque_at_film(&point, signed_slip_rad_s, contact_N, hbar_m, &out->model);
-        out->contact_force_N = contact_N;
-        clutch->film_hbar_m = wc_film_advance_m(&cal->film, cal->friction_area_m2, hbar_m, force_N,
-                                                model->film_damping_m4 * point.viscosity_Pa_s, cal->control_period_s);
+        wc_torque_at_film(&point, signed_slip_rad_s, film_contact_N, hbar_m, &out->model);
+        out->contact_force_N = film_contact_N;
+        clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
+                                                   model->film_damping_m4 * point.viscosity_Pa_s,
+                                                   cal->control_period_s);
     } else {
         wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
         out->contact_force_N = force_N;

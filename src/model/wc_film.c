@@ -4,6 +4,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "wc_film_internal.h"
 #include "wetclutch/wc_config.h"
 
 float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
@@ -42,7 +43,7 @@ float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
 
 /* The contact pressure at which the table's film is hbar_m (the inverse of
  * wc_film_hbar_m), and the secant dp_c/dh_bar of the segment that holds it
- * (finite and < 0: the nodes strictly decrease). */
+ * (finite and < 0: the nodes strictly decrease), for a valid table. */
 static float film_pressure_Pa(const wc_film_table_t *table, float hbar_m, float *secant_Pa_per_m)
 {
     const float *h = table->hbar_m;  /* strictly decreasing (wc_calibration_check) */
@@ -99,8 +100,22 @@ float wc_film_pressure_Pa(const wc_film_table_t *table, float hbar_m)
     return film_pressure_Pa(table, hbar_m, &secant_Pa_per_m);
 }
 
+wc_film_contact_t wc_film_contact(const wc_film_table_t *table, float hbar_m)
+{
+    wc_film_contact_t contact;
+    contact.pressure_Pa = film_pressure_Pa(table, hbar_m, &contact.secant_Pa_per_m);
+    return contact;
+}
+
 float wc_film_advance_m(const wc_film_table_t *table, float area_m2, float hbar_m, float apply_force_N,
                         float damping_N_s_m2, float dt_s)
+{
+    const wc_film_contact_t contact = wc_film_contact(table, hbar_m);
+    return wc_film_advance_at_m(table, area_m2, hbar_m, &contact, apply_force_N, damping_N_s_m2, dt_s);
+}
+
+float wc_film_advance_at_m(const wc_film_table_t *table, float area_m2, float hbar_m,
+                           const wc_film_contact_t *contact, float apply_force_N, float damping_N_s_m2, float dt_s)
 {
     /* Where the film settles under this force: eq. 16 (F_h = 0). */
     const float settled_m = wc_film_hbar_m(table, apply_force_N / area_m2);
@@ -109,8 +124,8 @@ float wc_film_advance_m(const wc_film_table_t *table, float area_m2, float hbar_
      * In u = 1 / h_bar^2 it reads D du/dt = 2 (F_app - F_c): the h_bar^3 of the
      * wide gap drops out (exact there), and the asperities' stiffness
      * dF_c/du = -A_f (dp_c/dh_bar) h_bar^3 / 2 >= 0 is taken implicitly. */
-    float secant_Pa_per_m;
-    const float squeeze_N = apply_force_N - area_m2 * film_pressure_Pa(table, hbar_m, &secant_Pa_per_m);
+    const float secant_Pa_per_m = contact->secant_Pa_per_m;
+    const float squeeze_N = apply_force_N - area_m2 * contact->pressure_Pa;
     const float hbar3_m3 = hbar_m * hbar_m * hbar_m;
     const float u_per_m2 = 1.0f / (hbar_m * hbar_m);
     const float du_per_m2 = 2.0f * dt_s * squeeze_N / (damping_N_s_m2 - dt_s * area_m2 * secant_Pa_per_m * hbar3_m3);
