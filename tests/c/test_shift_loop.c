@@ -1,0 +1,258 @@
+/* Shift mode in the CAN frame loop (include/wetclutch_can/wc_loop.h,
+ * src/can/wc_loop.c; DESIGN section 10): TorqueRequest Mode 3 and
+ * ShiftCommand frames from the generated codec, the shift on the plant of
+ * wc_test_fixtures.h, the ShiftReport frame, a stale command, the safe state
+ * after a shift, leaving Shift mode, Mode 3 without a shift calibration. */
+#include "wc_test_shift_harness.h"
+
+#include "wc_table1_calibration.h"
+#include "wetclutch_can/wc_loop.h"
+
+/* ======================================================================== */
+/* Frame loop in Shift mode                                                  */
+/* ======================================================================== */
+
+typedef struct {
+    wc_loop_t loop;
+    uint8_t alive;
+    float slip_rad_s;
+    bool offgoing_released;
+    uint32_t reports;
+    uint32_t steps;
+    wc_can_frame_t out[WC_LOOP_TX_FRAMES];
+    uint32_t n;
+    wc_can_shift_report_phys_t last_report;
+    wc_can_vfs_command_phys_t vfs;
+} loop_sim_t;
+
+static void loop_queue_sensors(loop_sim_t *l)
+{
+    wc_can_frame_t f;
+    assert_true(wc_test_shift_sensors_frame(&f, l->slip_rad_s, l->alive) <= WC_CAN_SATURATED);
+    assert_true(wc_loop_receive(&l->loop, &f));
+}
+
+static void loop_queue_request(loop_sim_t *l, uint8_t mode)
+{
+    wc_can_frame_t f;
+    assert_int_equal(wc_test_shift_request_frame(&f, mode, l->alive), WC_CAN_OK);
+    assert_true(wc_loop_receive(&l->loop, &f));
+}
+
+static void loop_queue_command(loop_sim_t *l, bool request, float turbine_torque_Nm, float target_ms)
+{
+    wc_can_frame_t f;
+    assert_int_equal(wc_test_shift_command_frame(&f, request, turbine_torque_Nm, target_ms, l->alive), WC_CAN_OK);
+    assert_true(wc_loop_receive(&l->loop, &f));
+}
+
+/* One period: the frames asked for, one step, the plant. */
+static void loop_period(loop_sim_t *l, bool sensors, int mode, int shift_request)
+{
+    if (sensors) { loop_queue_sensors(l); }
+    if (mode >= 0) { loop_queue_request(l, (uint8_t)mode); }
+    if (shift_request >= 0) { loop_queue_command(l, shift_request != 0, TURBINE_TORQUE_Nm, 1000.0f * TARGET_TIME_s); }
+    l->alive = wc_e2e_counter_next(l->alive);
+    memset(l->out, 0xA5, sizeof l->out);
+    l->n = wc_loop_step(&l->loop, l->out);
+    l->steps++;
+    WC_CHECK((l->n == WC_LOOP_TX_CYCLIC) || (l->n == WC_LOOP_TX_FRAMES), "%u frames", (unsigned)l->n);
+    assert_int_equal(l->out[0].id, WC_CAN_VFS_COMMAND_FRAME_ID);
+    assert_int_equal(l->out[1].id, WC_CAN_CLUTCH_ESTIMATE_FRAME_ID);
+    wc_can_vfs_command_phys_t vfs;
+    assert_true(wc_can_decode_vfs_command(&vfs, l->out[0].data, l->out[0].dlc) <= WC_CAN_SATURATED);
+    l->vfs = vfs;
+    if (l->n == WC_LOOP_TX_FRAMES) {
+        assert_int_equal(l->out[2].id, WC_CAN_SHIFT_REPORT_FRAME_ID);
+        assert_int_equal(l->out[2].dlc, WC_CAN_SHIFT_REPORT_LENGTH);
+        assert_int_equal(l->out[2].flags, 0u);
+        assert_true(wc_can_decode_shift_report(&l->last_report, l->out[2].data, l->out[2].dlc) <= WC_CAN_SATURATED);
+        l->reports++;
+    }
+    /* plant, as in sim_step, on the loop's clutch output */
+    if (l->loop.shift.phase == (uint32_t)WC_SHIFT_INERTIA) { l->offgoing_released = true; }
+    if (l->offgoing_released) {
+        l->slip_rad_s =
+            wc_test_shift_plant_slip_rad_s(&test_cal, l->slip_rad_s, TURBINE_TORQUE_Nm, &l->loop.last, DT_s);
+    }
+}
+
+static void loop_start(loop_sim_t *l, const wc_shift_calibration_t *cal)
+{
+    memset(l, 0, sizeof *l);
+    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    config.shift = cal;
+    assert_int_equal(wc_loop_init(&l->loop, &wc_table1_calibration, &config, THETA_OIL_degC), WC_CAL_OK);
+    l->slip_rad_s = START_SLIP_rad_s;
+    /* Shift mode, request 0, until the safe state is over (E2E sync + recovery) */
+    for (uint32_t k = 0u; k < WC_TEST_SHIFT_LOOP_SETTLE_PERIODS; ++k) {
+        loop_period(l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 0);
+    }
+    WC_CHECK((l->vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) == 0u, "still in the safe state: status %x",
+             (unsigned)l->vfs.status);
+    assert_int_equal(l->reports, 0u);
+}
+
+/* A value and its decoded frame: one raw step of the DBC scaling, plus the
+ * saturation to the signal's range. */
+static void check_signal(const char *what, float decoded, double expected, double lo, double hi, double step)
+{
+    const double clamped = (expected < lo) ? lo : ((expected > hi) ? hi : expected);
+    WC_CHECK_CLOSE(what, 0, decoded, clamped, 0.0, step);
+}
+
+static void test_loop_shift_report(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    loop_start(&l, &test_cal);
+    uint32_t report_step = 0u;
+    for (int k = 0; k < 2000; ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+        if (l.n == WC_LOOP_TX_FRAMES) { report_step = l.steps; }
+        WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) == 0u, "safe state during the shift");
+    }
+    assert_int_equal(l.reports, 1u);
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_LOCKED);
+    print_message("    loop: report at step %u\n", (unsigned)report_step);
+    const wc_shift_report_t *q = &l.loop.report;
+    print_report("loop shift", q);
+    assert_int_equal(q->abort_reason, WC_SHIFT_ABORT_NONE);
+    assert_int_equal(l.last_report.abort_reason, WC_SHIFT_ABORT_NONE);
+    check_signal("InertiaPhaseTime", l.last_report.inertia_phase_time_ms, 1000.0 * (double)q->inertia_time_s, 0.0, 4000.0,
+                 1.0);
+    check_signal("SlipRmse", l.last_report.slip_rmse_rpm, (double)q->slip_rmse_rad_s / (double)WC_RAD_S_PER_RPM, 0.0,
+                 500.0, 0.5);
+    check_signal("PeakJerk", l.last_report.peak_jerk_m_per_s3, (double)q->peak_jerk_m_s3, 0.0, 100.0, 0.1);
+    check_signal("FrictionEnergy", l.last_report.friction_energy_kJ, 1e-3 * (double)q->friction_energy_J, 0.0, 40.0, 0.01);
+    check_signal("PeakClutchTemp", l.last_report.peak_clutch_temp_degC, (double)q->peak_theta_degC, -40.0, 350.0, 0.1);
+    check_signal("Flare", l.last_report.flare, q->flare ? 1.0 : 0.0, 0.0, 1.0, 0.0);
+    check_signal("TieUp", l.last_report.tie_up, q->tie_up ? 1.0 : 0.0, 0.0, 1.0, 0.0);
+    WC_CHECK((q->inertia_time_s >= 0.9f * TARGET_TIME_s) && (q->inertia_time_s <= 1.15f * TARGET_TIME_s),
+             "inertia time %g s", (double)q->inertia_time_s);
+    assert_int_equal(l.loop.counters.frames_out, 2u * l.steps + 1u);
+    /* the request withdrawn after LOCKED: idle, no report */
+    for (int k = 0; k < 50; ++k) { loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 0); }
+    assert_int_equal(l.reports, 1u);
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_IDLE);
+}
+
+static void test_loop_shift_command_stale(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    loop_start(&l, &test_cal);
+    while (l.loop.shift.phase != (uint32_t)WC_SHIFT_INERTIA) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+        assert_true(l.steps < 1000u);
+    }
+    for (int k = 0; k < 50; ++k) { loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1); }
+    /* ShiftCommand stops: stale after request_timeout_periods (10) */
+    uint32_t first_timeout = 0u;
+    for (uint32_t k = 1u; k <= 30u; ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, -1);
+        if ((first_timeout == 0u) && ((l.vfs.status & WC_CAN_STATUS_REQUEST_TIMEOUT) != 0u)) {
+            first_timeout = k;
+            WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) != 0u, "timeout without the safe state");
+            WC_CHECK(fabsf(l.vfs.vfs_current_mA - wc_table1_calibration.vfs_current_min_mA) <= 0.5f,
+                     "safe state current %g mA", (double)l.vfs.vfs_current_mA);
+            assert_int_equal(l.n, WC_LOOP_TX_FRAMES);  /* the aborted shift's report, in the same step */
+            assert_int_equal(l.last_report.abort_reason, WC_SHIFT_ABORT_INPUT_LOST);
+        }
+    }
+    WC_CHECK((first_timeout >= 10u) && (first_timeout <= 12u), "StatusRequestTimeout after %u periods",
+             (unsigned)first_timeout);
+    assert_int_equal(l.reports, 1u);
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_ABORTED);
+    WC_CHECK(l.loop.counters.request_timeouts >= 1u, "request timeout not counted");
+}
+
+/* The frame loop's safe state after a completed shift (LOCKED, request still 1):
+ * the safe-state policy of wc_loop.h is the solenoid's minimum current. */
+static void test_loop_safe_state_after_shift_releases(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    loop_start(&l, &test_cal);
+    for (int k = 0; (k < 2000) && (l.loop.shift.phase != (uint32_t)WC_SHIFT_LOCKED); ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+    }
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_LOCKED);
+    for (int k = 0; k < 30; ++k) { loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, -1); }
+    WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) != 0u, "no safe state: status %x", (unsigned)l.vfs.status);
+    WC_CHECK(fabsf(l.vfs.vfs_current_mA - wc_table1_calibration.vfs_current_min_mA) <= 0.5f,
+             "StatusSafeStateActive with %g mA (shift phase %u): the safe state must be the minimum current",
+             (double)l.vfs.vfs_current_mA, (unsigned)l.loop.shift.phase);
+}
+
+/* After a completed shift the VCU hands the clutch back (Mode 2, Locked):
+ * the very first period in the new mode commands it (maximum current), with
+ * no period of the shift controller's released output in between (a 1 ms dip
+ * to the minimum current on the solenoid). */
+static void test_loop_leaving_shift_mode_after_the_shift_has_no_dip(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    loop_start(&l, &test_cal);
+    for (int k = 0; (k < 2000) && (l.loop.shift.phase != (uint32_t)WC_SHIFT_LOCKED); ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+    }
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_LOCKED);
+    const float max_mA = wc_table1_calibration.vfs_current_max_mA;
+    for (int k = 0; k < 20; ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE, 0);
+        WC_CHECK(fabsf(l.vfs.vfs_current_mA - max_mA) <= 0.5f, "period %d in Locked mode: %g mA, not the maximum %g",
+                 k, (double)l.vfs.vfs_current_mA, (double)max_mA);
+        assert_int_equal(l.n, WC_LOOP_TX_CYCLIC);  /* no second report */
+    }
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_IDLE);
+}
+
+static void test_loop_mode3_without_shift(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    memset(&l, 0, sizeof l);
+    const wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    assert_int_equal(wc_loop_init(&l.loop, &wc_table1_calibration, &config, THETA_OIL_degC), WC_CAL_OK);
+    l.slip_rad_s = START_SLIP_rad_s;
+    /* torque control first, out of the safe state */
+    for (int k = 0; k < 40; ++k) { loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE, -1); }
+    WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) == 0u, "safe state: %x", (unsigned)l.vfs.status);
+    const uint32_t implausible = l.loop.counters.rejected[WC_REJECT_IMPLAUSIBLE];
+    const uint32_t unknown = l.loop.counters.rejected[WC_REJECT_UNKNOWN_ID];
+    const uint32_t sync0 = l.loop.counters.rejected[WC_REJECT_SYNC];
+    const uint32_t used0 = l.loop.counters.frames_used;
+    /* mode 3 (and ShiftCommand frames) without config.shift */
+    for (int k = 0; k < 30; ++k) {
+        loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
+        if (k == 0) {
+            WC_CHECK((l.vfs.status & WC_CAN_STATUS_IMPLAUSIBLE_INPUT) != 0u, "mode 3 not flagged implausible");
+        }
+        assert_int_equal(l.n, WC_LOOP_TX_CYCLIC);
+    }
+    /* every TorqueRequest rejected: implausible, except the SyncCounter (3)
+     * frames after the request's timeout restarted its E2E receiver */
+    const uint32_t n_implausible = l.loop.counters.rejected[WC_REJECT_IMPLAUSIBLE] - implausible;
+    const uint32_t n_sync = l.loop.counters.rejected[WC_REJECT_SYNC] - sync0;
+    WC_CHECK((n_implausible + n_sync == 30u) && (n_sync <= 3u), "%u implausible, %u sync", (unsigned)n_implausible,
+             (unsigned)n_sync);
+    assert_int_equal(l.loop.counters.frames_used - used0, 30u);  /* the sensor frames only */
+    assert_int_equal(l.loop.counters.rejected[WC_REJECT_UNKNOWN_ID] - unknown, 30u);
+    WC_CHECK((l.vfs.status & WC_CAN_STATUS_REQUEST_TIMEOUT) != 0u, "the rejected requests did not time out");
+    WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) != 0u, "no safe state");
+    assert_int_equal(l.loop.shift.phase, WC_SHIFT_IDLE);
+    assert_int_equal(l.reports, 0u);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_loop_shift_report),
+        cmocka_unit_test(test_loop_shift_command_stale),
+        cmocka_unit_test(test_loop_safe_state_after_shift_releases),
+        cmocka_unit_test(test_loop_leaving_shift_mode_after_the_shift_has_no_dip),
+        cmocka_unit_test(test_loop_mode3_without_shift),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
