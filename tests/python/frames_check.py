@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wetclutch import canlog, replay
+from wetclutch import replay
+from wetclutch.util import canlog
 
 
 def _half_step(name: str, signal: str) -> float:

@@ -13,9 +13,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from wetclutch import bench, calibration, canlog, cli, model
-from wetclutch.csvio import read_columns
-from wetclutch.errors import LogError
+from wetclutch import bench, calibration, cli, model
+from wetclutch.util import canlog
+from wetclutch.util.csvio import read_columns
+from wetclutch.util.errors import LogError
 
 
 @pytest.fixture(scope="module")

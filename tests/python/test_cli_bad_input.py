@@ -31,7 +31,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch import atomic, canlog, cli, lut, model, reference
+from wetclutch import cli, lut, model, reference
+from wetclutch.util import atomic, canlog
 
 ROOT = Path(__file__).resolve().parents[2]
 TABLE1 = ROOT / "tools" / "calibrations" / "table1.toml"

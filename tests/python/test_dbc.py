@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from wetclutch import canlog
+from wetclutch.util import canlog
 
 cantools = pytest.importorskip("cantools")
 from cantools.database.can.c_source import camel_to_snake_case  # noqa: E402

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from frames_check import assert_frames_match_reference
-from wetclutch import calibration, canlog, replay
+from wetclutch import calibration, replay
+from wetclutch.util import canlog
 
 ROOT = Path(__file__).resolve().parents[2]
 LOGS = ROOT / "hil" / "logs"

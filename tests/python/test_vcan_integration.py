@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from frames_check import assert_frames_match_reference
-from wetclutch import canlog, replay
+from wetclutch import replay
+from wetclutch.util import canlog
 
 STEPS = 800
 BAD_CRC_STEP, SHORT_STEP, UNKNOWN_STEP = 300, 400, 500

@@ -120,7 +120,8 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.special import erf, erfc
 
-from . import atomic, calibration, canlog, model
+from . import calibration, model
+from .util import atomic, canlog
 from .calibration import Calibration
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -1023,7 +1024,7 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
     import struct
     import zlib as _zlib
 
-    from .errors import LogError
+    from .util.errors import LogError
 
     in_path, out_path = Path(in_path), Path(out_path)
     suffix = in_path.suffix.lower()

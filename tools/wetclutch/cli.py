@@ -8,9 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import atomic, calibration, lut, model, reference, shift_calibration, vectors
-from .csvio import CsvError, read_columns, write_columns
-from .errors import LogError
+from . import calibration, lut, model, reference, shift_calibration, vectors
+from .util import atomic
+from .util.csvio import CsvError, read_columns, write_columns
+from .util.errors import LogError
 
 DEFAULT_CAL = "tools/calibrations/table1.toml"
 

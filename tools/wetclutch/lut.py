@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from . import model
-from .atomic import Staged
+from .util.atomic import Staged
 from .calibration import FILM_MAX_NODES, PARAMETERS, Calibration, film_problem
 
 FLOAT_BYTES = 4

@@ -34,7 +34,7 @@ import numpy as np
 
 from . import model
 from .calibration import Calibration
-from .csvio import CsvError
+from .util.csvio import CsvError
 
 INPUTS = {
     "torque": ("slip_rpm", "theta_degC", "force_N"),

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import canlog, model
+from . import model
+from .util import canlog
 from .calibration import Calibration
 
 ROOT = canlog.ROOT

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import atomic, canlog, model, plotting, replay
+from . import model, replay
+from .util import atomic, canlog, plotting
 from .calibration import Calibration
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15

@@ -54,8 +54,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import canlog, plant as plant_mod, shift_calibration, shift_reference
-from .atomic import Staged
+from . import plant as plant_mod, shift_calibration, shift_reference
+from .util import canlog
+from .util.atomic import Staged
 
 ROOT = Path(__file__).resolve().parents[2]
 WC_REPLAY = ROOT / "build" / "host-release" / "src" / "host" / "wc_replay"
@@ -540,7 +541,7 @@ def markdown(cases: dict, tg: dict) -> str:
 def plot_case(path: Path, runs: dict, title: str) -> None:
     """Fig. 4-style panels of one scenario, the controllers overlaid: speeds, slip and its reference, clutch
     torque, pressure and current, vehicle acceleration and jerk, clutch temperature (true and estimated)."""
-    from . import plotting
+    from .util import plotting
     fig, axes = plotting.subplots(3, 2, figsize=(13, 11), sharex=True)
     colors = {"feedback": "tab:red", "blind": "tab:orange", "full": "tab:blue", "nolag": "tab:gray"}
     for ctrl, rec in runs.items():

@@ -19,7 +19,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from .atomic import Staged
+from .util.atomic import Staged
 from .lut import c_float as _c_float, c_identifier
 
 

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import atomic, model, reference
+from . import model, reference
+from .util import atomic
 from .calibration import Calibration
 from .lut import banner
 

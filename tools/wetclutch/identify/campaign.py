@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import csvio
+from ..util import csvio
 from ..calibration import Calibration
 from .settings import IdentifyError, Settings
 from .signals import Exclusion, prepare_friction, prepare_thermal

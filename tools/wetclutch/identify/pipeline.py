@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from .. import lut
-from ..atomic import Staged
+from ..util.atomic import Staged
 from ..calibration import Calibration, CalibrationError, load as load_calibration, render_calibration
 from .campaign import Campaign, find_campaigns, find_viscosity, prepare_campaign
 from .edges import identify_film, identify_static, read_runs

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import model, plotting
+from .. import model
+from ..util import plotting
 from ..calibration import Calibration
 from ..model import RAD_S_PER_RPM
 from .friction import hbar_of_force, mu_grid

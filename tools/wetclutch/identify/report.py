@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import model
-from ..atomic import Staged
+from ..util.atomic import Staged
 from .friction import identify_mu, mu_grid
 from .plots import plots as make_plots
 from .result import identified_values

@@ -17,7 +17,7 @@ import numpy as np
 
 from .errors import LogError
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DBC_PATH = ROOT / "hil" / "wetclutch.dbc"
 
 SENSORS, REQUEST, COMMAND, ESTIMATE, BENCH = (
