@@ -78,7 +78,6 @@ static void test_every_float_field_rejects_non_finite(void **state)
     }
 }
 
-
 /* The limits are inclusive where the header says so: at the limit accepted,
  * one float beyond it rejected. */
 typedef struct {
@@ -295,7 +294,6 @@ static void test_first_failing_field_is_reported(void **state)
     c.cal.film.length = 0u;                  /* the film last */
     expect_code(&c.cal, WC_CAL_FRICTION_PAIRS, "friction_pairs and film", 0.0);
 }
-
 
 static void test_error_names(void **state)
 {

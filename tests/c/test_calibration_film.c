@@ -8,8 +8,6 @@
  * wc_test_calibration_harness.h. */
 #include "wc_test_calibration_harness.h"
 
-#include <float.h>
-
 /* ------------------------------------------------------------------------ */
 /* The film table                                                             */
 

@@ -67,7 +67,6 @@ static inline void expect_code(const wc_calibration_t *cal, wc_cal_error_t expec
     }
 }
 
-
 /* ------------------------------------------------------------------------ */
 /* The float fields                                                          */
 
