@@ -5,7 +5,7 @@
 #       raw pack/unpack, `cantools generate_c_source`;
 #   include/wetclutch_can/wc_can_signals.h, src/can/generated/wc_can_signals.c
 #       signal descriptors, status bits, physical frame structs and
-#       encode/decode, `python -m wetclutch.can_descriptors` (same DBC).
+#       encode/decode, `python -m wetclutch.generate.can_descriptors` (same DBC).
 #
 #   tools/gen_can_codec.sh [OUTPUT_ROOT]    default: the repository root
 #   PYTHON=/path/to/python tools/gen_can_codec.sh
@@ -73,5 +73,5 @@ grep -q '^#include "wetclutch_can/wc_can.h"$' "$out/src/can/generated/wc_can.c" 
   exit 1
 }
 
-(cd "$repo/tools" && "$py" -W error -m wetclutch.can_descriptors "$repo/$dbc" \
+(cd "$repo/tools" && "$py" -W error -m wetclutch.generate.can_descriptors "$repo/$dbc" \
     "$out/include/wetclutch_can/wc_can_signals.h" "$out/src/can/generated/wc_can_signals.c")

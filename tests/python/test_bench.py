@@ -13,7 +13,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from wetclutch import bench, calibration, cli, model
+from wetclutch import bench, calibration, cli
+from wetclutch.reference import model
 from wetclutch.util import canlog
 from wetclutch.util.csvio import read_columns
 from wetclutch.util.errors import LogError

@@ -24,7 +24,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch import calibration, lut
+from wetclutch import calibration
+from wetclutch.generate import lut
 from wetclutch.calibration import C_NAMES, LIMITS, CalibrationError
 
 ROOT = Path(__file__).resolve().parents[2]

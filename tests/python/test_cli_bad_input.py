@@ -31,7 +31,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch import cli, lut, model, reference
+from wetclutch import cli
+from wetclutch.generate import lut
+from wetclutch.reference import evaluate as reference, model
 from wetclutch.util import atomic, canlog
 
 ROOT = Path(__file__).resolve().parents[2]

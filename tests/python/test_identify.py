@@ -23,7 +23,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch import calibration, identify, lut, model
+from wetclutch import calibration, identify
+from wetclutch.generate import lut
+from wetclutch.reference import model
 
 ROOT = Path(__file__).resolve().parents[2]
 TABLE1 = ROOT / "tools" / "calibrations" / "table1.toml"

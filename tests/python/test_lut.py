@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch import lut, model
+from wetclutch.generate import lut
+from wetclutch.reference import model
 
 
 def test_error_bound_and_size(cal):

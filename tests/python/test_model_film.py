@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wetclutch import bench, calibration, model
+from wetclutch import bench, calibration
+from wetclutch.reference import model
 from wetclutch.identify import friction
 
 # Linear interpolation on nodes uniform in h: the error is at most dh^2/8 max|f''|, so it falls with the

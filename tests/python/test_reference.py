@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from wetclutch import model
+from wetclutch.reference import model
 
 
 def test_effective_radius_from_radii(cal):

@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 from vcan_support import needs_vcan
-from wetclutch import calibration, model, plant, shift, shift_calibration
+from wetclutch import calibration, plant, shift
+from wetclutch.calibration import shift as shift_calibration
+from wetclutch.reference import model
 
 ROOT = Path(__file__).resolve().parents[2]
 

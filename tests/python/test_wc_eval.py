@@ -22,10 +22,12 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 try:
-    from wetclutch import calibration, reference
+    from wetclutch import calibration
+    from wetclutch.reference import evaluate as reference
 except ImportError:  # the tool not installed in this interpreter: use the source tree
     sys.path.insert(0, str(ROOT / "tools"))
-    from wetclutch import calibration, reference
+    from wetclutch import calibration
+    from wetclutch.reference import evaluate as reference
 
 
 def _find_wc_eval() -> Path:

@@ -120,7 +120,8 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.special import erf, erfc
 
-from . import calibration, model
+from . import calibration
+from .reference import model
 from .util import atomic, canlog
 from .calibration import Calibration
 

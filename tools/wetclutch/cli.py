@@ -8,7 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import calibration, lut, model, reference, shift_calibration, vectors
+from . import calibration
+from .calibration import shift as shift_calibration
+from .generate import lut, shift_header, vectors
+from .reference import evaluate as reference, model
 from .util import atomic
 from .util.csvio import CsvError, read_columns, write_columns
 from .util.errors import LogError
@@ -20,7 +23,7 @@ def _cmd_lut(args) -> int:
     lut.check_max_error(args.max_error)   # before any work: NaN or <= 0 would disable the check
     if shift_calibration.is_shift_calibration(args.calibration):   # a [shift] table: the shift controller's
         command = f"wetclutch lut {args.calibration} --out {args.out}"
-        written = shift_calibration.write_header(shift_calibration.load(args.calibration), Path(args.out), command)
+        written = shift_header.write_header(shift_calibration.load(args.calibration), Path(args.out), command)
         print(f"wrote {written}")
         return 0
     cal = calibration.load(args.calibration)

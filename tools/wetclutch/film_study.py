@@ -18,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import bench, calibration, model
+from . import bench, calibration
+from .reference import model
 from .util import atomic
 from .calibration import Calibration
 from .identify import edges

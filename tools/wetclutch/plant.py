@@ -62,7 +62,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import calibration, model
+from . import calibration
+from .reference import model
 from .bench import _Physics
 
 RPM = model.RAD_S_PER_RPM          # rad/s per rpm

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import model
+from .reference import model
 from .util import canlog
 from .calibration import Calibration
 

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import model, replay
+from . import replay
+from .reference import model
 from .util import atomic, canlog, plotting
 from .calibration import Calibration
 

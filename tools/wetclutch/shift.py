@@ -54,7 +54,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plant as plant_mod, shift_calibration, shift_reference
+from . import plant as plant_mod
+from .calibration import shift as shift_calibration
+from .reference import shift as shift_reference
 from .util import canlog
 from .util.atomic import Staged
 

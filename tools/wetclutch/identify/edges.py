@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import t as student_t
 
-from .. import model
+from ..reference import model
 from ..calibration import Calibration
 from .campaign import MEASUREMENT_COLUMNS, OPTIONAL_COLUMNS, Campaign, read_table
 from .settings import IdentifyError

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 
-from .. import model
+from ..reference import model
 from ..calibration import Calibration
-from ..model import RAD_S_PER_RPM
+from ..reference.model import RAD_S_PER_RPM
 from .campaign import stack
 from .settings import IdentifyError, Settings
 from .statistics import check_identifiable, confidence, r2_rmse

@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from .. import lut
+from ..calibration import film_table
 from ..util.atomic import Staged
 from ..calibration import Calibration, CalibrationError, load as load_calibration, render_calibration
 from .campaign import Campaign, find_campaigns, find_viscosity, prepare_campaign
@@ -160,10 +160,10 @@ def write_outputs(res: Result, base_path: Path, out_dir: Path, command: str, tru
                 raise IdentifyError("the identified calibration is rejected by calibration.load: "
                                     + str(e).replace(str(tmp), str(cal_path))) from None
             try:
-                table = lut.build_table(check)
-            except lut.TableError as e:
+                table = film_table.build_table(check)
+            except film_table.TableError as e:
                 raise IdentifyError(f"the identified calibration makes no film table: {e}") from None
-        lut_error = lut.max_relative_error(check, table)
+        lut_error = film_table.max_relative_error(check, table)
         return write_report(res, out_dir, command, truth, str(true_path) if true_path else None,
                             {"path": str(cal_path), "lut_max_rel_error": lut_error,
                              "lut_nodes": int(table.pressure_Pa.size)}, plots)

@@ -8,10 +8,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import model
+from ..reference import model
 from ..util import plotting
 from ..calibration import Calibration
-from ..model import RAD_S_PER_RPM
+from ..reference.model import RAD_S_PER_RPM
 from .friction import hbar_of_force, mu_grid
 
 if TYPE_CHECKING:

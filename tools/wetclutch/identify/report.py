@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import model
+from ..reference import model
 from ..util.atomic import Staged
 from .friction import identify_mu, mu_grid
 from .plots import plots as make_plots

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import fftconvolve, savgol_filter
 
-from ..model import RAD_S_PER_RPM
+from ..reference.model import RAD_S_PER_RPM
 from .settings import Settings
 
 # ---------------------------------------------------------------------------

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import model, reference
-from .util import atomic
-from .calibration import Calibration
+from ..calibration import Calibration
+from ..reference import evaluate as reference, model
+from ..util import atomic
 from .lut import banner
 
 SLIP_RPM = (-750.0, 0.0, 0.5, 3.0, 12.0, 50.0, 100.0, 300.0, 750.0, 1500.0, 3000.0)

@@ -30,11 +30,15 @@ line and the rule, as wc_eval does, and writes the columns wc_eval writes;
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from . import model
-from .calibration import Calibration
-from .util.csvio import CsvError
+from ..util.csvio import CsvError
+
+if TYPE_CHECKING:   # annotations only: the reference reads a calibration's attributes, the loader sits above it
+    from ..calibration.parameters import Calibration
 
 INPUTS = {
     "torque": ("slip_rpm", "theta_degC", "force_N"),

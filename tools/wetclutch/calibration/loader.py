@@ -1,0 +1,64 @@
+"""Loading a calibration file: TOML, units, sources, the firmware's rules (rules.py) and the film table it gives
+(film_table.py)."""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from . import film_table
+from .parameters import PARAMETERS, Calibration, CalibrationError
+from .rules import _check_relations, _check_value
+
+
+def load(path: str | Path) -> Calibration:
+    """Read and validate a calibration file. Raises CalibrationError."""
+    path = str(path)
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except OSError as e:
+        raise CalibrationError(f"{path}: cannot read calibration file: {e.strerror}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise CalibrationError(f"{path}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {e.start}): not a calibration file") from None
+
+    known = {(s, n) for s, n, *_ in PARAMETERS}
+    for section, table in doc.items():
+        if not isinstance(table, dict):
+            raise CalibrationError(f"{path}: '{section}' must be a table of parameters")
+        for name in table:
+            if (section, name) not in known:
+                raise CalibrationError(f"{path}: unknown parameter '{section}.{name}'")
+
+    values: dict[str, float] = {}
+    sources: dict[str, str] = {}
+    for section, name, unit, constraint, field in PARAMETERS:
+        qualified = f"{section}.{name}"
+        entry = doc.get(section, {}).get(name)
+        if entry is None:
+            raise CalibrationError(f"{path}: missing parameter '{qualified}' (unit {unit})")
+        if not isinstance(entry, dict) or "value" not in entry:
+            raise CalibrationError(
+                f"{path}: parameter '{qualified}' must be {{ value = ..., unit = \"{unit}\", source = \"...\" }}")
+        if entry.get("unit") != unit:
+            raise CalibrationError(
+                f"{path}: parameter '{qualified}': unit {entry.get('unit')!r}, expected {unit!r}")
+        source = entry.get("source")
+        if not isinstance(source, str) or not source.strip():
+            raise CalibrationError(f"{path}: parameter '{qualified}': missing 'source' (paper table or reason)")
+        values[name] = _check_value(path, qualified, entry["value"], constraint, field, unit)
+        sources[name] = source
+
+    cal = Calibration(values, sources, path)
+    _check_relations(cal)
+    _check_film(cal)
+    return cal
+
+
+def _check_film(cal: Calibration) -> None:
+    """The film table `wetclutch lut` would write from this calibration must pass the firmware's rules."""
+    try:
+        film_table.build_table(cal)
+    except film_table.TableError as e:
+        raise CalibrationError(str(e)) from None

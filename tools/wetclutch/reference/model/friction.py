@@ -1,0 +1,80 @@
+"""Viscosity (eq. 2), friction coefficient (eq. 18), torque (eq. 3-8), static capacity and the force at the
+maximum current."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .constants import RAD_S_PER_RPM
+from .film import hbar_from_pressure_m
+
+if TYPE_CHECKING:   # annotations only: the model reads a calibration's attributes, the loader sits above it
+    from ...calibration.parameters import Calibration
+
+
+def viscosity_Pa_s(cal: Calibration, theta_degC):
+    """mu_v(theta), eq. 2."""
+    th = np.asarray(theta_degC, dtype=float)
+    return cal.mv1 * np.exp(cal.mv2 * th) + cal.mv3 * np.exp(cal.mv4 * th)
+
+
+def viscosity_slope_Pa_s_per_K(cal: Calibration, theta_degC):
+    """d mu_v / d theta, from eq. 2."""
+    th = np.asarray(theta_degC, dtype=float)
+    return cal.mv1 * cal.mv2 * np.exp(cal.mv2 * th) + cal.mv3 * cal.mv4 * np.exp(cal.mv4 * th)
+
+
+def friction_coefficient(cal: Calibration, speed_m_s, theta_degC):
+    """mu_f(v, theta), eq. 18 (Stribeck exponential x linear temperature)."""
+    v = np.abs(np.asarray(speed_m_s, dtype=float))
+    th = np.asarray(theta_degC, dtype=float)
+    stribeck = cal.mu1 + (cal.mu2 - cal.mu1) * np.exp(-v / cal.stribeck_speed)
+    return stribeck * (1.0 + cal.mu3 * (th - cal.theta1) / cal.theta2)
+
+
+def torque_at_film_Nm(cal: Calibration, slip_rpm, theta_degC, contact_force_N, hbar_m):
+    """Eq. 5-8 for a contact force and the film it stands on, signed with the slip (arrays)."""
+    return torque_parts(cal, slip_rpm, theta_degC, contact_force_N, hbar_m=hbar_m)["torque_Nm"]
+
+
+def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
+    """Static capacity: static factor mu_f(0, theta) R_eff N_c F_c (DESIGN 9; eq. 18 at v = 0)."""
+    return (cal.static_friction_factor * friction_coefficient(cal, 0.0, theta_degC)
+            * cal.effective_radius * cal.friction_pairs * np.asarray(contact_force_N, dtype=float))
+
+
+def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None):
+    """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
+
+    hbar_m: the film the contact force stands on; default the steady film of eq. 16 (the squeeze-film
+    state of DESIGN 9 passes its own).
+
+    Torques carry the sign of the slip speed (slip >= 0 counts as positive):
+    the torque transmitted through the slipping clutch, which acts against
+    the slip on the faster member. At zero slip the Coulomb part is the
+    static capacity mu_f(0, theta) F_c R_eff N_c and the viscous part is 0.
+    """
+    slip = np.asarray(slip_rpm, dtype=float)
+    force = np.asarray(force_N, dtype=float)
+    theta = np.asarray(theta_degC, dtype=float)
+    sign = np.where(slip < 0.0, -1.0, 1.0)
+    speed = cal.effective_radius * np.abs(slip) * RAD_S_PER_RPM          # eq. 4
+    mu_f = friction_coefficient(cal, speed, theta)                       # eq. 18
+    hbar = (hbar_from_pressure_m(cal, force / cal.friction_area)          # eq. 9, 15, 16
+            if hbar_m is None else np.asarray(hbar_m, dtype=float))
+    rn = cal.effective_radius * cal.friction_pairs
+    coulomb = rn * mu_f * force                                          # eq. 6
+    viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / hbar  # eq. 7
+    return {
+        "torque_Nm": sign * (coulomb + viscous),                         # eq. 5, 8
+        "coulomb_Nm": sign * coulomb,
+        "viscous_Nm": sign * viscous,
+        "hbar_m": hbar,
+        "mu_f": mu_f,
+    }
+
+
+def force_max_N(cal: Calibration) -> float:
+    """Contact force at the solenoid's maximum current: K i_max A_p - F_s."""
+    return max(cal.vfs_gain * cal.vfs_current_max * cal.piston_area - cal.return_spring_force, 0.0)
