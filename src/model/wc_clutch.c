@@ -83,11 +83,12 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ti
  * pressure of that force, as a current, goes to lead_lag. contact_N is the
  * asperity force F_c(h_bar) of the film state. */
 static void lead_film(const wc_model_t *model, float hbar_m, float contact_N, float viscosity_Pa_s, float time_s,
-                      wc_inverse_t *inv)
+                      uint32_t film_segment, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
     if (!(model->film_damping_m4 > 0.0f) || !(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return; }
-    const float target_hbar_m = wc_film_hbar_m(&cal->film, inv->force_N / cal->friction_area_m2);
+    /* the inverse found the force on film_segment: the lookup starts there */
+    const float target_hbar_m = wc_film_hbar_near_m(&cal->film, inv->force_N / cal->friction_area_m2, film_segment);
     if (!(hbar_m > target_hbar_m)) { return; }  /* at or past the wanted film: the steady force */
     const float squeeze_N = model->film_damping_m4 * viscosity_Pa_s * (hbar_m - target_hbar_m) /
                             (time_s * hbar_m * hbar_m * hbar_m);  /* h_bar >= the table's minimum: finite */
@@ -122,10 +123,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     wc_torque_point(model, u->slip_rad_s, out->theta_degC, &point);
     const float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
     wc_inverse_t inv;
+    uint32_t film_segment = WC_FILM_NO_SEGMENT;  /* of the commanded force: where the lookups below start */
     if ((in->mode == WC_MODE_TORQUE) && clutch->lockup.locked) {
         status |= wc_inverse_holding(model, static_Nm_per_N, u->torque_request_Nm, &inv);  /* DESIGN 9 */
     } else if (in->mode == WC_MODE_TORQUE) {
-        status |= wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv);
+        status |= wc_inverse_at_point(model, &point, u->torque_request_Nm, &inv, &film_segment);
     } else {
         if (in->mode != WC_MODE_LOCKED && in->mode != WC_MODE_OPEN) { status |= WC_STATUS_TORQUE_INVALID; }
         const wc_calibration_t *cal = model->cal;
@@ -142,7 +144,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
     const float film_contact_N = model->cal->friction_area_m2 * contact.pressure_Pa;
     const bool lead = (in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f);
-    if (lead) { lead_film(model, hbar_m, film_contact_N, point.viscosity_Pa_s, in->lag_compensation_time_s, &inv); }
+    if (lead) {
+        lead_film(model, hbar_m, film_contact_N, point.viscosity_Pa_s, in->lag_compensation_time_s, film_segment, &inv);
+    }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv); }
     out->current_mA = inv.current_mA;
@@ -174,9 +178,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         out->contact_force_N = film_contact_N;
         clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
                                                    model->film_damping_m4 * point.viscosity_Pa_s,
-                                                   cal->control_period_s);
+                                                   cal->control_period_s, film_segment);
     } else {
-        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
+        /* eq. 16: the paper's steady film */
+        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, film_segment, &out->model);
         out->contact_force_N = force_N;
     }
 

@@ -13,18 +13,27 @@ float wc_film_hbar_m(const wc_film_table_t *table, float pressure_Pa)
     if ((table == NULL) || (table->pressure_Pa == NULL) || (table->hbar_m == NULL) || (table->length < 2u)) {
         return 0.0f;  /* contract violation with asserts off */
     }
+    return wc_film_hbar_near_m(table, pressure_Pa, WC_FILM_NO_SEGMENT);
+}
+
+float wc_film_hbar_near_m(const wc_film_table_t *table, float pressure_Pa, uint32_t segment)
+{
     const float *p = table->pressure_Pa;
     const uint32_t last = table->length - 1u;
     /* Clamp; the negated compare also sends NaN to the open-clutch end. */
     if (!(pressure_Pa > p[0])) { return table->hbar_m[0]; }
     if (pressure_Pa >= p[last]) { return table->hbar_m[last]; }
 
-    /* Binary search for p[lo] <= pressure < p[hi]; at most log2(length) halvings. */
-    uint32_t lo = 0u;
-    uint32_t hi = last;
-    for (uint32_t guard = 0u; (guard < 32u) && (hi - lo > 1u); ++guard) {
-        const uint32_t mid = lo + (hi - lo) / 2u;
-        if (p[mid] <= pressure_Pa) { lo = mid; } else { hi = mid; }
+    uint32_t lo = segment;
+    uint32_t hi = segment + 1u;
+    if (!((segment < last) && (p[lo] <= pressure_Pa) && (pressure_Pa < p[hi]))) {
+        /* Binary search for p[lo] <= pressure < p[hi]; at most log2(length) halvings. */
+        lo = 0u;
+        hi = last;
+        for (uint32_t guard = 0u; (guard < 32u) && (hi - lo > 1u); ++guard) {
+            const uint32_t mid = lo + (hi - lo) / 2u;
+            if (p[mid] <= pressure_Pa) { lo = mid; } else { hi = mid; }
+        }
     }
 
     /* Cubic Hermite with the exact slopes d h_bar / d p_c at both nodes. */
@@ -111,14 +120,16 @@ float wc_film_advance_m(const wc_film_table_t *table, float area_m2, float hbar_
                         float damping_N_s_m2, float dt_s)
 {
     const wc_film_contact_t contact = wc_film_contact(table, hbar_m);
-    return wc_film_advance_at_m(table, area_m2, hbar_m, &contact, apply_force_N, damping_N_s_m2, dt_s);
+    return wc_film_advance_at_m(table, area_m2, hbar_m, &contact, apply_force_N, damping_N_s_m2, dt_s,
+                                WC_FILM_NO_SEGMENT);
 }
 
 float wc_film_advance_at_m(const wc_film_table_t *table, float area_m2, float hbar_m,
-                           const wc_film_contact_t *contact, float apply_force_N, float damping_N_s_m2, float dt_s)
+                           const wc_film_contact_t *contact, float apply_force_N, float damping_N_s_m2, float dt_s,
+                           uint32_t segment)
 {
     /* Where the film settles under this force: eq. 16 (F_h = 0). */
-    const float settled_m = wc_film_hbar_m(table, apply_force_N / area_m2);
+    const float settled_m = wc_film_hbar_near_m(table, apply_force_N / area_m2, segment);
     /* DESIGN section 9, eq. 10 with Reynolds' squeeze force between annular
      * plates: F_app = F_c(h_bar) + D (-dh_bar/dt) / h_bar^3, D = 3 pi phi mu_v K / 2.
      * In u = 1 / h_bar^2 it reads D du/dt = 2 (F_app - F_c): the h_bar^3 of the

@@ -128,12 +128,13 @@ static float solve_segment(const wc_film_table_t *film, float area_m2, const wc_
 }
 
 wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
-                                wc_inverse_t *out)
+                                wc_inverse_t *out, uint32_t *film_segment)
 {
     const wc_calibration_t *cal = model->cal;
     const wc_film_table_t *film = &cal->film;
     wc_status_t status = WC_STATUS_OK;
     out->iterations = 0u;
+    *film_segment = WC_FILM_NO_SEGMENT;
 
     /* At F_c = 0 the film is the table's first (thickest, clamped) node. */
     if (torque_request_Nm * film->hbar_m[0] <= point->viscous_Nm_m) {
@@ -163,6 +164,7 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
     } else {
         const wc_segment_t s = find_segment(film, area_m2, point, torque_request_Nm, excess_first, excess_last);
         force_N = solve_segment(film, area_m2, point, torque_request_Nm, &s, &out->iterations);
+        *film_segment = s.node;
     }
     /* The root lies in (0, F_max]: keep float rounding from stepping outside. */
     force_N = (force_N > 0.0f) ? force_N : 0.0f;
@@ -222,5 +224,6 @@ wc_status_t wc_inverse(const wc_model_t *model, float slip_rad_s, float theta_de
     }
     wc_torque_point_t point;
     wc_torque_point(model, slip_rad_s, theta_degC, &point);
-    return wc_inverse_at_point(model, &point, torque_request_Nm, out);
+    uint32_t film_segment;
+    return wc_inverse_at_point(model, &point, torque_request_Nm, out, &film_segment);
 }

@@ -11,6 +11,7 @@
 #include "wetclutch/wc_model.h"
 #include "wetclutch/wc_status.h"
 #include "wetclutch/wc_torque.h"
+#include "wc_film_internal.h"
 
 typedef struct {
     float coulomb_Nm_per_N;  /* R_eff N_c mu_f(v, theta), eq. 6 */
@@ -23,13 +24,18 @@ typedef struct {
 /* mu_f, mu_v at a valid (slip, theta). */
 void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point);
 
-/* eq. 5-8 at the point for a valid force_N, signed with the slip. */
+/* eq. 5-8 at the point for a valid force_N, signed with the slip; the film
+ * table's segment `film_segment` is tried first (wc_film_hbar_near_m:
+ * the same torque whatever it is; WC_FILM_NO_SEGMENT: none known). */
 void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
-                        wc_torque_t *out);
+                        uint32_t film_segment, wc_torque_t *out);
 
-/* The inverse at the point for a valid torque_request_Nm (wc_inverse.h). */
+/* The inverse at the point for a valid torque_request_Nm (wc_inverse.h).
+ * *film_segment: the film table's segment that holds the force found, for
+ * the lookups that follow at nearby forces; WC_FILM_NO_SEGMENT when the force
+ * was not solved on a segment (below drag, saturated, outside the table). */
 wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
-                                wc_inverse_t *out);
+                                wc_inverse_t *out, uint32_t *film_segment);
 
 /* The inverse for a locked clutch (DESIGN 9): the force whose static capacity
  * (static_Nm_per_N > 0 per newton) holds torque_request_Nm with the

@@ -32,10 +32,10 @@ static void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out)
 }
 
 void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
-                        wc_torque_t *out)
+                        uint32_t film_segment, wc_torque_t *out)
 {
-    /* eq. 16: steady film, p_c = F_c / A_f */
-    const float hbar_m = wc_film_hbar_m(&model->cal->film, force_N / model->cal->friction_area_m2);
+    /* eq. 16: steady film, p_c = F_c / A_f (the table passed the calibration check at init) */
+    const float hbar_m = wc_film_hbar_near_m(&model->cal->film, force_N / model->cal->friction_area_m2, film_segment);
     wc_torque_at_film(point, slip_rad_s, force_N, hbar_m, out);
 }
 
@@ -61,6 +61,6 @@ wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_deg
     }
     wc_torque_point_t point;
     wc_torque_point(model, slip_rad_s, theta_degC, &point);
-    wc_torque_at_point(model, &point, slip_rad_s, force_N, out);
+    wc_torque_at_point(model, &point, slip_rad_s, force_N, WC_FILM_NO_SEGMENT, out);
     return WC_STATUS_OK;
 }
