@@ -32,6 +32,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "wc_field_ranges.h"
 #include "wc_internal.h"
 
 /* x in [lo, hi]. False for NaN (every comparison with NaN is false), and for
@@ -41,83 +42,91 @@ static bool within(float x, float lo, float hi) { return (x >= lo) && (x <= hi);
 static float larger(float a, float b) { return (a > b) ? a : b; }
 static float smaller(float a, float b) { return (a < b) ? a : b; }
 
-/* The range of each float field, in declaration order: [low, high], or
- * (low, high] with low_open. The relations between fields come after. */
-typedef struct {
-    uint16_t offset;   /* offsetof(wc_calibration_t, field) */
-    uint8_t code;      /* wc_cal_error_t */
-    uint8_t low_open;
-    float low;
-    float high;
-} wc_field_limit_t;
+/* The range of each scalar field, in declaration order, which is the order
+ * of the codes: member, code, flags (wc_field_ranges.h), low, high. The
+ * relations between fields come after (check_relations). */
+#define WC_CAL_FIELD_RANGES(X) \
+    X(outer_radius_m, WC_CAL_OUTER_RADIUS, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_RADIUS_MAX_m) \
+    X(inner_radius_m, WC_CAL_INNER_RADIUS, WC_FIELD_LOW_OPEN, 0.0f, FLT_MAX)       /* and < R_o */ \
+    X(friction_area_m2, WC_CAL_FRICTION_AREA, WC_FIELD_LOW_OPEN, 0.0f, FLT_MAX)    /* and <= pi R_o^2 */ \
+    X(piston_area_m2, WC_CAL_PISTON_AREA, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_PISTON_AREA_MAX_m2) \
+    X(friction_pairs, WC_CAL_FRICTION_PAIRS, WC_FIELD_INTEGER, 1.0f, (float)WC_CAL_LIMIT_FRICTION_PAIRS_MAX) \
+    X(oil_conductance_W_per_K, WC_CAL_OIL_CONDUCTANCE, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K) \
+    X(housing_conductance_W_per_K, WC_CAL_HOUSING_CONDUCTANCE, 0u, 0.0f, WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K) \
+    X(heat_capacity_J_per_K, WC_CAL_HEAT_CAPACITY, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_HEAT_CAPACITY_MAX_J_per_K) \
+    /* mu_v(0 degC) = a1 + a2: a coefficient above the mu_v limit fails anyway */ \
+    X(viscosity_a1_Pa_s, WC_CAL_VISCOSITY_A1, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s) \
+    X(viscosity_b1_per_K, WC_CAL_VISCOSITY_B1, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K, \
+      WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K) \
+    X(viscosity_a2_Pa_s, WC_CAL_VISCOSITY_A2, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s) \
+    X(viscosity_b2_per_K, WC_CAL_VISCOSITY_B2, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K, \
+      WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K) \
+    X(mu1, WC_CAL_MU1, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX) \
+    X(mu2, WC_CAL_MU2, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX) \
+    X(mu3, WC_CAL_MU3, 0u, -FLT_MAX, FLT_MAX)                                      /* finite */ \
+    X(stribeck_speed_m_s, WC_CAL_STRIBECK_SPEED, 0u, WC_CAL_LIMIT_STRIBECK_SPEED_MIN_m_s, \
+      WC_CAL_LIMIT_STRIBECK_SPEED_MAX_m_s) \
+    X(theta1_degC, WC_CAL_THETA1, 0u, WC_THETA_MIN_degC, WC_THETA_MAX_degC) \
+    X(theta2_K, WC_CAL_THETA2, 0u, WC_CAL_LIMIT_THETA2_MIN_K, FLT_MAX) \
+    X(vfs_gain_Pa_per_mA, WC_CAL_VFS_GAIN, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_VFS_GAIN_MAX_Pa_per_mA) \
+    X(vfs_time_constant_s, WC_CAL_VFS_TIME_CONSTANT, 0u, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MIN_s, \
+      WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s) \
+    X(return_spring_force_N, WC_CAL_RETURN_SPRING_FORCE, 0u, 0.0f, WC_CAL_LIMIT_SPRING_FORCE_MAX_N) \
+    X(vfs_current_min_mA, WC_CAL_VFS_CURRENT_MIN, 0u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA) \
+    X(vfs_current_max_mA, WC_CAL_VFS_CURRENT_MAX, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA) /* and > i_min */ \
+    X(control_period_s, WC_CAL_CONTROL_PERIOD, 0u, WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s, \
+      WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s) \
+    X(film_squeeze_factor, WC_CAL_FILM_SQUEEZE_FACTOR, 0u, 0.0f, WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MAX) \
+    X(static_friction_factor, WC_CAL_STATIC_FRICTION_FACTOR, 0u, WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MIN, \
+      WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MAX) \
+    X(lock_slip_rad_s, WC_CAL_LOCK_SLIP, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s) \
+    X(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s) \
+    X(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, WC_CAL_LIMIT_HOLDING_MARGIN_MIN, WC_CAL_LIMIT_HOLDING_MARGIN_MAX) \
+    X(lock_dwell_periods, WC_CAL_LOCK_DWELL, WC_FIELD_INTEGER, 1.0f, (float)WC_CAL_LIMIT_LOCK_DWELL_MAX_periods)
 
-#define WC_FIELD(member, code, low_open, low, high) \
-    { (uint16_t)offsetof(wc_calibration_t, member), (uint8_t)(code), (low_open), (low), (high) }
+#define WC_CAL_RANGE(member, code, flags, low, high) { (low), (high) },
+#define WC_CAL_FLAGS(member, code, flags, low, high) (uint8_t)(flags),
+/* Field i fails with code WC_CAL_OUTER_RADIUS + i: each field sits at its code's word. */
+#define WC_CAL_AT_ITS_CODE(member, code, flags, low, high) \
+    WC_STATIC_ASSERT(offsetof(wc_calibration_t, member) == 4u * (size_t)((code) - WC_CAL_OUTER_RADIUS), \
+                     member##_sits_at_its_code);
 
-static const wc_field_limit_t field_limits[] = {
-    WC_FIELD(outer_radius_m, WC_CAL_OUTER_RADIUS, 1u, 0.0f, WC_CAL_LIMIT_RADIUS_MAX_m),
-    WC_FIELD(inner_radius_m, WC_CAL_INNER_RADIUS, 1u, 0.0f, FLT_MAX),           /* and < R_o */
-    WC_FIELD(friction_area_m2, WC_CAL_FRICTION_AREA, 1u, 0.0f, FLT_MAX),        /* and <= pi R_o^2 */
-    WC_FIELD(piston_area_m2, WC_CAL_PISTON_AREA, 1u, 0.0f, WC_CAL_LIMIT_PISTON_AREA_MAX_m2),
-    WC_FIELD(oil_conductance_W_per_K, WC_CAL_OIL_CONDUCTANCE, 1u, 0.0f, WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K),
-    WC_FIELD(housing_conductance_W_per_K, WC_CAL_HOUSING_CONDUCTANCE, 0u, 0.0f,
-             WC_CAL_LIMIT_CONDUCTANCE_MAX_W_per_K),
-    WC_FIELD(heat_capacity_J_per_K, WC_CAL_HEAT_CAPACITY, 1u, 0.0f, WC_CAL_LIMIT_HEAT_CAPACITY_MAX_J_per_K),
-    /* mu_v(0 degC) = a1 + a2: a coefficient above the mu_v limit fails anyway */
-    WC_FIELD(viscosity_a1_Pa_s, WC_CAL_VISCOSITY_A1, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s),
-    WC_FIELD(viscosity_b1_per_K, WC_CAL_VISCOSITY_B1, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K,
-             WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K),
-    WC_FIELD(viscosity_a2_Pa_s, WC_CAL_VISCOSITY_A2, 0u, 0.0f, WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s),
-    WC_FIELD(viscosity_b2_per_K, WC_CAL_VISCOSITY_B2, 0u, -WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K,
-             WC_CAL_LIMIT_VISCOSITY_EXPONENT_MAX_per_K),
-    WC_FIELD(mu1, WC_CAL_MU1, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX),
-    WC_FIELD(mu2, WC_CAL_MU2, 0u, WC_CAL_LIMIT_MU_MIN, WC_CAL_LIMIT_MU_MAX),
-    WC_FIELD(mu3, WC_CAL_MU3, 0u, -FLT_MAX, FLT_MAX),                           /* finite */
-    WC_FIELD(stribeck_speed_m_s, WC_CAL_STRIBECK_SPEED, 0u, WC_CAL_LIMIT_STRIBECK_SPEED_MIN_m_s,
-             WC_CAL_LIMIT_STRIBECK_SPEED_MAX_m_s),
-    WC_FIELD(theta1_degC, WC_CAL_THETA1, 0u, WC_THETA_MIN_degC, WC_THETA_MAX_degC),
-    WC_FIELD(theta2_K, WC_CAL_THETA2, 0u, WC_CAL_LIMIT_THETA2_MIN_K, FLT_MAX),
-    WC_FIELD(vfs_gain_Pa_per_mA, WC_CAL_VFS_GAIN, 1u, 0.0f, WC_CAL_LIMIT_VFS_GAIN_MAX_Pa_per_mA),
-    WC_FIELD(vfs_time_constant_s, WC_CAL_VFS_TIME_CONSTANT, 0u, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MIN_s,
-             WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s),
-    WC_FIELD(return_spring_force_N, WC_CAL_RETURN_SPRING_FORCE, 0u, 0.0f, WC_CAL_LIMIT_SPRING_FORCE_MAX_N),
-    WC_FIELD(vfs_current_min_mA, WC_CAL_VFS_CURRENT_MIN, 0u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA),
-    WC_FIELD(vfs_current_max_mA, WC_CAL_VFS_CURRENT_MAX, 1u, 0.0f, WC_CAL_LIMIT_CURRENT_MAX_mA), /* and > i_min */
-    WC_FIELD(control_period_s, WC_CAL_CONTROL_PERIOD, 0u, WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s,
-             WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s),
-    WC_FIELD(film_squeeze_factor, WC_CAL_FILM_SQUEEZE_FACTOR, 0u, 0.0f, WC_CAL_LIMIT_FILM_SQUEEZE_FACTOR_MAX),
-    WC_FIELD(static_friction_factor, WC_CAL_STATIC_FRICTION_FACTOR, 0u, WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MIN,
-             WC_CAL_LIMIT_STATIC_FRICTION_FACTOR_MAX),
-    WC_FIELD(lock_slip_rad_s, WC_CAL_LOCK_SLIP, 1u, 0.0f, WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s),
-    WC_FIELD(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP, 1u, 0.0f, WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s),
-    WC_FIELD(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, WC_CAL_LIMIT_HOLDING_MARGIN_MIN, WC_CAL_LIMIT_HOLDING_MARGIN_MAX),
-};
+static const wc_field_range_t field_range[] = { WC_CAL_FIELD_RANGES(WC_CAL_RANGE) };
+static const uint8_t field_flags[] = { WC_CAL_FIELD_RANGES(WC_CAL_FLAGS) };
+static const wc_field_rules_t field_rules = { field_range, field_flags, sizeof field_flags };
+WC_CAL_FIELD_RANGES(WC_CAL_AT_ITS_CODE)
+/* Every scalar field has its range: the last one is the last before the film table. */
+WC_STATIC_ASSERT(sizeof field_flags == (size_t)(WC_CAL_LOCK_DWELL - WC_CAL_OUTER_RADIUS + 1), one_range_per_code);
+WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == sizeof field_flags * 4u, every_scalar_field_has_a_range);
+WC_STATIC_ASSERT((sizeof(float) == 4u) && (sizeof(uint32_t) == 4u), fields_are_words);
 
-/* Every float field has its range: the float fields fill the struct up to
- * lock_dwell_periods, but for friction_pairs (checked after piston_area_m2);
- * the two counts are checked by check_fields. */
-WC_STATIC_ASSERT(sizeof field_limits / sizeof field_limits[0] ==
-                     (offsetof(wc_calibration_t, lock_dwell_periods) - sizeof(uint32_t)) / sizeof(float),
-                 every_float_field_has_a_range);
-WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) <= UINT16_MAX, field_offsets_fit_uint16);
+uint32_t wc_field_first_invalid(const void *fields, const wc_field_rules_t *rules)
+{
+    const unsigned char *base = (const unsigned char *)fields;
+    float previous = 0.0f;
+    for (uint32_t i = 0u; (i < 32u) && (i < rules->count); ++i) {
+        const uint32_t flags = rules->flags[i];
+        float x;
+        if ((flags & WC_FIELD_INTEGER) != 0u) {
+            uint32_t n;
+            memcpy(&n, base + 4u * i, sizeof n);
+            x = (float)n;  /* exact against the integer bounds: floats are exact up to 2^24 */
+        } else {
+            memcpy(&x, base + 4u * i, sizeof x);
+        }
+        const float low = ((flags & WC_FIELD_LOW_PREVIOUS) != 0u) ? previous : rules->range[i].low;
+        const bool above_low = ((flags & WC_FIELD_LOW_OPEN) != 0u) ? (x > low) : (x >= low);
+        const bool off = ((flags & WC_FIELD_OR_ZERO) != 0u) && within(x, 0.0f, 0.0f);
+        if (!off && !(above_low && (x <= rules->range[i].high))) { return i; }
+        previous = x;
+    }
+    return rules->count;
+}
 
 static wc_cal_error_t check_fields(const wc_calibration_t *cal)
 {
-    for (size_t i = 0u; i < sizeof field_limits / sizeof field_limits[0]; ++i) {
-        const wc_field_limit_t *f = &field_limits[i];
-        float x;
-        memcpy(&x, (const unsigned char *)cal + f->offset, sizeof x);
-        const bool above_low = (f->low_open != 0u) ? (x > f->low) : (x >= f->low);
-        if (!above_low || !(x <= f->high)) { return (wc_cal_error_t)f->code; }
-        if ((f->code == WC_CAL_PISTON_AREA) &&
-            ((cal->friction_pairs == 0u) || (cal->friction_pairs > WC_CAL_LIMIT_FRICTION_PAIRS_MAX))) {
-            return WC_CAL_FRICTION_PAIRS;  /* in declaration order, after A_p */
-        }
-    }
-    if ((cal->lock_dwell_periods == 0u) || (cal->lock_dwell_periods > WC_CAL_LIMIT_LOCK_DWELL_MAX_periods)) {
-        return WC_CAL_LOCK_DWELL;  /* the last scalar field */
-    }
-    return WC_CAL_OK;
+    const uint32_t i = wc_field_first_invalid(cal, &field_rules);
+    return (i < field_rules.count) ? (wc_cal_error_t)((uint32_t)WC_CAL_OUTER_RADIUS + i) : WC_CAL_OK;
 }
 
 /* One term a e^(b theta) of eq. 2 at both ends of the domain, added to the

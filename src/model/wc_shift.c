@@ -3,45 +3,60 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "wc_field_ranges.h"
 #include "wc_internal.h"
 
 /* A value in [lo, hi] (false for NaN). */
 static bool in_closed(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
 
-/* A time that is 0 (off) or within [1e-3, WC_SHIFT_LIMIT_TIME_MAX_s]. */
-static bool off_or_time(float value_s) { return in_closed(value_s, 0.0f, 0.0f) || in_closed(value_s, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s); }
+/* The range of each field, in declaration order, which is the order of the
+ * codes: member, code, flags (wc_field_ranges.h), low, high. A time "0 or
+ * within": 0 switches it off. */
+#define WC_SHIFT_FIELD_RANGES(X) \
+    X(turbine_inertia_kg_m2, WC_SHIFT_CAL_TURBINE_INERTIA, 0u, 1e-4f, 100.0f) \
+    X(turbine_ratio, WC_SHIFT_CAL_TURBINE_RATIO, 0u, 0.05f, 20.0f) \
+    X(output_inertia_kg_m2, WC_SHIFT_CAL_OUTPUT_INERTIA, 0u, 1e-4f, 1e5f) \
+    X(output_ratio, WC_SHIFT_CAL_OUTPUT_RATIO, 0u, 0.05f, 20.0f) \
+    X(jerk_per_torque_rate, WC_SHIFT_CAL_JERK_PER_TORQUE_RATE, 0u, 0.0f, 1.0f) \
+    X(prepare_time_s, WC_SHIFT_CAL_PREPARE_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(torque_phase_time_s, WC_SHIFT_CAL_TORQUE_PHASE_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(inertia_time_min_s, WC_SHIFT_CAL_INERTIA_TIME_MIN, 0u, WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s, \
+      WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s) \
+    X(inertia_time_max_s, WC_SHIFT_CAL_INERTIA_TIME_MAX, WC_FIELD_LOW_PREVIOUS, 0.0f, \
+      WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s)                                     /* >= inertia_time_min_s */ \
+    X(inertia_timeout_factor, WC_SHIFT_CAL_INERTIA_TIMEOUT_FACTOR, 0u, 1.05f, 10.0f) \
+    X(lockup_ramp_time_s, WC_SHIFT_CAL_LOCKUP_RAMP_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(holding_torque_factor, WC_SHIFT_CAL_HOLDING_TORQUE_FACTOR, 0u, 1.0f, 5.0f) \
+    X(min_start_slip_rad_s, WC_SHIFT_CAL_MIN_START_SLIP, 0u, 0.0f, WC_SLIP_MAX_rad_s) \
+    X(feedforward_gain, WC_SHIFT_CAL_FEEDFORWARD_GAIN, 0u, 0.0f, 2.0f) \
+    X(kp_Nm_per_rad_s, WC_SHIFT_CAL_KP, 0u, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX) \
+    X(ki_Nm_per_rad, WC_SHIFT_CAL_KI, 0u, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX) \
+    X(integral_limit_Nm, WC_SHIFT_CAL_INTEGRAL_LIMIT, 0u, 0.0f, WC_TORQUE_MAX_Nm) \
+    X(lag_compensation_time_s, WC_SHIFT_CAL_LAG_COMPENSATION_TIME, WC_FIELD_OR_ZERO, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(theta_source, WC_SHIFT_CAL_THETA_SOURCE, WC_FIELD_INTEGER, 0.0f, (float)WC_SHIFT_THETA_OIL) \
+    X(flare_slip_rad_s, WC_SHIFT_CAL_FLARE_SLIP, 0u, 0.0f, WC_SLIP_MAX_rad_s) \
+    X(tie_up_factor, WC_SHIFT_CAL_TIE_UP_FACTOR, 0u, 1.0f, 10.0f) \
+    X(jerk_filter_time_s, WC_SHIFT_CAL_JERK_FILTER_TIME, WC_FIELD_OR_ZERO, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s)
+
+#define WC_SHIFT_RANGE(member, code, flags, low, high) { (low), (high) },
+#define WC_SHIFT_FLAGS(member, code, flags, low, high) (uint8_t)(flags),
+/* Field i fails with code WC_SHIFT_CAL_TURBINE_INERTIA + i: each field sits at its code's word. */
+#define WC_SHIFT_AT_ITS_CODE(member, code, flags, low, high) \
+    WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, member) == 4u * (size_t)((code) - WC_SHIFT_CAL_TURBINE_INERTIA), \
+                     shift_##member##_sits_at_its_code);
+
+static const wc_field_range_t field_range[] = { WC_SHIFT_FIELD_RANGES(WC_SHIFT_RANGE) };
+static const uint8_t field_flags[] = { WC_SHIFT_FIELD_RANGES(WC_SHIFT_FLAGS) };
+static const wc_field_rules_t field_rules = { field_range, field_flags, sizeof field_flags };
+WC_SHIFT_FIELD_RANGES(WC_SHIFT_AT_ITS_CODE)
+WC_STATIC_ASSERT(sizeof field_flags == (size_t)(WC_SHIFT_CAL_ERRORS - WC_SHIFT_CAL_TURBINE_INERTIA), one_range_per_code);
+WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == sizeof field_flags * 4u, every_field_has_a_range);
 
 wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal)
 {
     if (cal == NULL) { return WC_SHIFT_CAL_NULL; }
-    const float tmax = WC_SHIFT_LIMIT_TIME_MAX_s;
-    if (!in_closed(cal->turbine_inertia_kg_m2, 1e-4f, 100.0f)) { return WC_SHIFT_CAL_TURBINE_INERTIA; }
-    if (!in_closed(cal->turbine_ratio, 0.05f, 20.0f)) { return WC_SHIFT_CAL_TURBINE_RATIO; }
-    if (!in_closed(cal->output_inertia_kg_m2, 1e-4f, 1e5f)) { return WC_SHIFT_CAL_OUTPUT_INERTIA; }
-    if (!in_closed(cal->output_ratio, 0.05f, 20.0f)) { return WC_SHIFT_CAL_OUTPUT_RATIO; }
-    if (!in_closed(cal->jerk_per_torque_rate, 0.0f, 1.0f)) { return WC_SHIFT_CAL_JERK_PER_TORQUE_RATE; }
-    if (!in_closed(cal->prepare_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_PREPARE_TIME; }
-    if (!in_closed(cal->torque_phase_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_TORQUE_PHASE_TIME; }
-    if (!in_closed(cal->inertia_time_min_s, WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s, WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s)) {
-        return WC_SHIFT_CAL_INERTIA_TIME_MIN;
-    }
-    if (!in_closed(cal->inertia_time_max_s, cal->inertia_time_min_s, WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s)) {
-        return WC_SHIFT_CAL_INERTIA_TIME_MAX;
-    }
-    if (!in_closed(cal->inertia_timeout_factor, 1.05f, 10.0f)) { return WC_SHIFT_CAL_INERTIA_TIMEOUT_FACTOR; }
-    if (!in_closed(cal->lockup_ramp_time_s, 0.0f, tmax)) { return WC_SHIFT_CAL_LOCKUP_RAMP_TIME; }
-    if (!in_closed(cal->holding_torque_factor, 1.0f, 5.0f)) { return WC_SHIFT_CAL_HOLDING_TORQUE_FACTOR; }
-    if (!in_closed(cal->min_start_slip_rad_s, 0.0f, WC_SLIP_MAX_rad_s)) { return WC_SHIFT_CAL_MIN_START_SLIP; }
-    if (!in_closed(cal->feedforward_gain, 0.0f, 2.0f)) { return WC_SHIFT_CAL_FEEDFORWARD_GAIN; }
-    if (!in_closed(cal->kp_Nm_per_rad_s, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX)) { return WC_SHIFT_CAL_KP; }
-    if (!in_closed(cal->ki_Nm_per_rad, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX)) { return WC_SHIFT_CAL_KI; }
-    if (!in_closed(cal->integral_limit_Nm, 0.0f, WC_TORQUE_MAX_Nm)) { return WC_SHIFT_CAL_INTEGRAL_LIMIT; }
-    if (!off_or_time(cal->lag_compensation_time_s)) { return WC_SHIFT_CAL_LAG_COMPENSATION_TIME; }
-    if (cal->theta_source > (uint32_t)WC_SHIFT_THETA_OIL) { return WC_SHIFT_CAL_THETA_SOURCE; }
-    if (!in_closed(cal->flare_slip_rad_s, 0.0f, WC_SLIP_MAX_rad_s)) { return WC_SHIFT_CAL_FLARE_SLIP; }
-    if (!in_closed(cal->tie_up_factor, 1.0f, 10.0f)) { return WC_SHIFT_CAL_TIE_UP_FACTOR; }
-    if (!off_or_time(cal->jerk_filter_time_s)) { return WC_SHIFT_CAL_JERK_FILTER_TIME; }
-    return WC_SHIFT_CAL_OK;
+    const uint32_t i = wc_field_first_invalid(cal, &field_rules);
+    return (i < field_rules.count) ? (wc_shift_cal_error_t)((uint32_t)WC_SHIFT_CAL_TURBINE_INERTIA + i) : WC_SHIFT_CAL_OK;
 }
 
 void wc_shift_init(wc_shift_t *shift)
