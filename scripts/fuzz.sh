@@ -11,14 +11,16 @@
 #   FUZZ_SECONDS   time per harness (libFuzzer -max_total_time), default 60
 #   FUZZ_RUNS      stop a harness after this many executions instead (-runs)
 #   FUZZ_FLAGS     extra libFuzzer flags, e.g. "-seed=1 -max_len=8192"
+#   FUZZ_PARALLEL  harnesses run side by side (default 1), one core each
+#   FUZZ_BUILD_ONLY=1  build the harnesses and stop
 #   WC_FUZZ_LAX=1  fuzz_model checks the arithmetic helpers only inside the
 #                  domain the library calls them with (default: every input)
 #
 # Prints per harness: executions, exec/s, coverage (cov: edges, ft: features),
 # corpus size, time. Exits non-zero when a harness crashes or an oracle is
 # violated, naming the reproducer (build/fuzz/artifacts/<name>/crash-...) and
-# the command that replays it. One fuzzer at a time, one process each
-# (no -jobs/-workers): the machine is shared.
+# the command that replays it. One process per harness (no -jobs/-workers);
+# FUZZ_PARALLEL=2 runs two harnesses side by side (scripts/test.sh on 2 cores).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
@@ -78,12 +80,16 @@ if ! cmake --build "$build" --parallel 2 >"$probe/build.log" 2>&1; then
 fi
 
 # --- run
+[ "${FUZZ_BUILD_ONLY:-0}" = 1 ] && { echo "== fuzz: built (FUZZ_BUILD_ONLY=1)"; exit 0; }
+
 work=$(mktemp -d)
 trap 'rm -rf "$probe" "$work"' EXIT
 mkdir -p "$build/logs"
-failed=0
-summary=()
-for h in "${harnesses[@]}"; do
+# One harness: its findings replayed, then fuzzed; its summary line goes to
+# $work/summary_<h>, a failure to $work/failed_<h> (so harnesses can run side by side).
+fuzz_one() {
+  local h=$1 exe corpus artifacts log limit bound max_len findings start rc elapsed execs rate covline cov ft corp line own repro
+  local -a summary_line
   exe="$build/fuzz_$h"
   corpus="$work/corpus_$h"
   artifacts="$build/artifacts/$h"
@@ -102,12 +108,13 @@ for h in "${harnesses[@]}"; do
   findings=(tests/fuzz/findings/"$h"-*)
   if [ -e "${findings[0]}" ]; then
     if ! "$exe" "${findings[@]}" >"$build/logs/fuzz_${h}_findings.log" 2>&1; then
-      failed=1
+      echo 1 >"$work/failed_$h"
       grep -E -B2 -A6 'ORACLE VIOLATION|WC_ASSERT FAILED|ERROR: AddressSanitizer|runtime error' \
         "$build/logs/fuzz_${h}_findings.log" | head -30 || true
       echo "fuzz: $h FAILED on a recorded finding (tests/fuzz/findings/README.md); log: $build/logs/fuzz_${h}_findings.log"
-      summary+=("$(printf '%-12s' "$h") FAILED: a recorded finding fails again (tests/fuzz/findings)")
-      continue
+      summary_line=("$(printf '%-12s' "$h") FAILED: a recorded finding fails again (tests/fuzz/findings)")
+      printf '%s\n' "${summary_line[@]}" >"$work/summary_$h"
+      return
     fi
     echo "== fuzz: $h: ${#findings[@]} recorded findings replayed, ok"
   fi
@@ -132,18 +139,44 @@ for h in "${harnesses[@]}"; do
   own=$(grep -E "^fuzz_$h: [0-9]+ inputs" "$log" | tail -1 || true)
   [ -n "$own" ] && echo "   $own"
   if [ $rc -ne 0 ]; then
-    failed=1
+    echo 1 >"$work/failed_$h"
     repro=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
     [ -n "$repro" ] || repro=$(ls -t "$artifacts"/* 2>/dev/null | head -1 || true)
     echo "$line  FAILED (exit $rc)"
     grep -E -A8 'ORACLE VIOLATION|WC_ASSERT FAILED|ERROR: AddressSanitizer|runtime error|ERROR: libFuzzer' "$log" | head -30 || true
     echo "fuzz: $h FAILED: reproducer ${repro:-<none written; see $log>}"
     [ -n "$repro" ] && echo "fuzz: replay with: $exe $repro"
-    summary+=("$line  FAILED: ${repro:-see $log}")
+    summary_line=("$line  FAILED: ${repro:-see $log}")
   else
     echo "$line  ok"
-    summary+=("$line  ok")
+    summary_line=("$line  ok")
   fi
+  printf '%s\n' "${summary_line[@]}" >"$work/summary_$h"
+}
+
+# FUZZ_PARALLEL harnesses at a time (default 1); each is one libFuzzer process
+# on one core for its full time, so running two on two cores gives each the
+# executions it has alone. The output of each is printed when it ends, whole.
+parallel=${FUZZ_PARALLEL:-1}
+case $parallel in ''|*[!0-9]*|0) echo "fuzz: FUZZ_PARALLEL must be a positive integer" >&2; exit 2 ;; esac
+pending=("${harnesses[@]}")
+while [ ${#pending[@]} -gt 0 ]; do
+  batch=("${pending[@]:0:$parallel}")
+  pending=("${pending[@]:$parallel}")
+  if [ ${#batch[@]} -eq 1 ]; then
+    fuzz_one "${batch[0]}"
+  else
+    pids=()
+    for h in "${batch[@]}"; do fuzz_one "$h" >"$work/out_$h" 2>&1 & pids+=($!); done
+    for i in "${!batch[@]}"; do wait "${pids[$i]}" || true; cat "$work/out_${batch[$i]}"; done
+  fi
+done
+failed=0
+summary=()
+for h in "${harnesses[@]}"; do
+  [ -f "$work/failed_$h" ] && failed=1
+  [ -f "$work/summary_$h" ] && summary+=("$(cat "$work/summary_$h")")
+  [ -f "$work/summary_$h" ] || { failed=1; summary+=("$(printf '%-12s' "$h") FAILED: no summary (the harness's run died)"); }
 done
 
 echo "== fuzz: summary"

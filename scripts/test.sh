@@ -2,39 +2,104 @@
 # All tests: installs what is missing, builds the host (sanitized) and the
 # Cortex-M4F presets, runs static analysis, the Cortex-M4F checks and
 # instruction counts, the package check, the fuzzers (60 s each), the C unit
-# tests (ctest) and the Python tests (pytest).
+# tests (ctest) and the Python tests (pytest), then prints the time per stage.
+#
+#   bash scripts/test.sh           # everything: the README's and CI's test command
+#   bash scripts/test.sh --quick   # the edit-compile-test loop (under 3 min): static analysis,
+#                                  # ctest and the Python tests not marked slow (no vcan, HIL,
+#                                  # shift matrix, film study, identification, in-process replays)
+#
+# Both cores are used where that weakens nothing: two fuzzers side by side
+# (each on its own core for its full 60 s, so each gets the executions it gets
+# alone), the third beside the static analysis and the Cortex-M4F and package
+# checks, and pytest on two workers (pytest-xdist; each test module on one
+# worker, tests/python/conftest.py).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
-bash scripts/setup.sh
 
-echo "== build: host-debug (address + undefined sanitizers)"
-cmake --preset host-debug >/dev/null
-cmake --build --preset host-debug
+quick=0
+case "${1:-}" in
+  "") ;;
+  --quick) quick=1 ;;
+  *) echo "test: unknown option '$1' (usage: bash scripts/test.sh [--quick])" >&2; exit 2 ;;
+esac
 
-echo "== static analysis (cppcheck gating; MISRA C:2012 counts)"
-bash scripts/static_analysis.sh build/host-debug
+stage_names=()
+stage_seconds=()
+started_s=$SECONDS
+report() {  # the time per stage, also after a failure
+  local rc=$?
+  echo
+  echo "== time per stage (wall clock, s)"
+  for i in "${!stage_names[@]}"; do printf '%6d  %s\n' "${stage_seconds[$i]}" "${stage_names[$i]}"; done
+  printf '%6d  total%s\n' "$((SECONDS - started_s))" "$([ "$rc" -eq 0 ] || echo ", FAILED (exit $rc)")"
+  # The Python runner's summary closes the output (tests/python ran, and how many).
+  if [ -s "${pytest_log:-}" ]; then tail -n 1 "$pytest_log"; fi
+}
+pytest_log=$(mktemp)
+trap 'report; rm -f "$pytest_log"' EXIT
+stage() {  # stage NAME CMD...: run CMD, record its wall time
+  local name=$1 t0=$SECONDS
+  shift
+  echo "== $name"
+  "$@"
+  stage_names+=("$name")
+  stage_seconds+=("$((SECONDS - t0))")
+}
 
-echo "== build: host-release (wc_tcu for the vcan and HIL tests, wc_eval)"
-cmake --preset host-release >/dev/null
-cmake --build --preset host-release
+build() {
+  cmake --preset host-debug >/dev/null
+  cmake --build --preset host-debug
+  if [ "$quick" = 0 ]; then  # wc_tcu for the vcan and HIL tests, wc_replay, wc_eval
+    cmake --preset host-release >/dev/null
+    cmake --build --preset host-release
+  fi
+}
 
-echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
-bash scripts/check_arm.sh
+checks() {  # one core's worth, run beside the third fuzzer (called in an || list: no set -e here)
+  echo "== static analysis (cppcheck gating; MISRA C:2012 counts)"
+  bash scripts/static_analysis.sh build/host-debug || return
+  echo "== build: cortex-m4f (-Werror, no heap/stdio/double libm)"
+  bash scripts/check_arm.sh || return
+  echo "== Cortex-M4F instruction counts (QEMU -icount; fails above bench/arm_ceilings.txt)"
+  bash scripts/bench_arm.sh || return
+  echo "== package: find_package(wetclutch) after install, and add_subdirectory(), host and Cortex-M4F"
+  bash scripts/check_package.sh
+}
 
-echo "== Cortex-M4F instruction counts (QEMU -icount; fails above bench/arm_ceilings.txt)"
-bash scripts/bench_arm.sh
+fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints whole when done
+  local dir rc_fuzz=0 rc_checks=0
+  dir=$(mktemp -d)
+  FUZZ_BUILD_ONLY=0 bash scripts/fuzz.sh calibration >"$dir/fuzz" 2>&1 & local fuzz_pid=$!
+  checks >"$dir/checks" 2>&1 || rc_checks=$?
+  cat "$dir/checks"
+  wait "$fuzz_pid" || rc_fuzz=$?
+  cat "$dir/fuzz"
+  rm -rf "$dir"
+  [ "$rc_checks" -eq 0 ] || { echo "test: the checks FAILED (exit $rc_checks)" >&2; return "$rc_checks"; }
+  [ "$rc_fuzz" -eq 0 ] || { echo "test: fuzz calibration FAILED (exit $rc_fuzz)" >&2; return "$rc_fuzz"; }
+}
 
-echo "== package: find_package(wetclutch) after install, and add_subdirectory(), host and Cortex-M4F"
-bash scripts/check_package.sh
+python_tests() {
+  export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
+  export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
+  local args=(-n 2 --dist loadgroup -ra)
+  [ "$quick" = 1 ] && args+=(-m "not slow")
+  # pytest's own exit code, its output shown as it comes (and its summary kept for the end)
+  .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log"
+  return "${PIPESTATUS[0]}"
+}
 
-echo "== libFuzzer harnesses (ASan + UBSan), 60 s each from the committed corpora (scripts/fuzz.sh)"
-bash scripts/fuzz.sh
-
-echo "== C unit tests (ctest)"
-ctest --test-dir build/host-debug --output-on-failure
-
-echo "== Python tests (pytest)"
-export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
-export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
-exec .venv/bin/python -m pytest tests/python -ra
+stage "setup (scripts/setup.sh)" bash scripts/setup.sh
+stage "build: host-debug (address + undefined sanitizers)$([ "$quick" = 0 ] && echo ", host-release")" build
+if [ "$quick" = 1 ]; then
+  stage "static analysis (cppcheck gating; MISRA C:2012 counts)" bash scripts/static_analysis.sh build/host-debug
+else
+  stage "build: libFuzzer harnesses (ASan + UBSan)" env FUZZ_BUILD_ONLY=1 bash scripts/fuzz.sh
+  stage "fuzz: model and loop side by side (60 s each)" env FUZZ_PARALLEL=2 bash scripts/fuzz.sh model loop
+  stage "fuzz: calibration (60 s) beside static analysis, Cortex-M4F checks and counts, package check" \
+    fuzz_and_checks
+fi
+stage "C unit tests (ctest)" ctest --test-dir build/host-debug --output-on-failure
+stage "Python tests (pytest on 2 workers)" python_tests

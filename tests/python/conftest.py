@@ -36,3 +36,39 @@ def tcu() -> Path:
             pytest.fail(message)
         pytest.skip(message)
     return path
+
+
+
+# --------------------------------------------------------------------------- how scripts/test.sh runs them
+# slow: left out by `scripts/test.sh --quick` (the edit-compile-test loop); the full command runs all.
+# vcan: boots a QEMU guest (or uses the host's vcan).
+# With pytest-xdist (`-n 2 --dist loadgroup`) each module is one group, run by one worker, so a
+# module's fixtures (a replay, the shift matrix) run once; the longest modules are handed out first
+# (LONGEST_FIRST, measured seconds of each on a 2-core machine), so the two workers end together.
+SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
+                "test_shift", "test_film_study", "test_identify", "test_replay_inproc"}
+VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner"}
+VCAN_TESTS = {"test_vcan_shift_equals_in_process"}
+LONGEST_FIRST = ("test_hil_replay", "test_shift", "test_cli_bad_input", "test_vcan_integration", "test_identify",
+                 "test_vcan_port_faults", "test_replay_inproc", "test_vcan_runner", "test_film_study", "test_lut")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: left out by scripts/test.sh --quick")
+    config.addinivalue_line("markers", "vcan: needs a vcan (natively or in a QEMU guest)")
+
+
+def _module(item) -> str:
+    return item.module.__name__.rsplit(".", 1)[-1]
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        module = _module(item)
+        if module in SLOW_MODULES:
+            item.add_marker(pytest.mark.slow)
+        if module in VCAN_MODULES or (item.originalname or item.name) in VCAN_TESTS:
+            item.add_marker(pytest.mark.vcan)
+        item.add_marker(pytest.mark.xdist_group(module))
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(_module(item), len(rank)))   # stable: file order otherwise
