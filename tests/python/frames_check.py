@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wetclutch import replay
+from wetclutch.hil import replay
 from wetclutch.util import canlog
 
 

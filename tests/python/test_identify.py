@@ -429,7 +429,7 @@ def test_unindexed_measurement_is_named(small):
 
 def _bench():
     try:
-        from wetclutch import bench
+        from wetclutch.simulate import bench
     except ImportError:
         return None
     needed = ("run", "table2_experiments", "thermal_experiments", "Experiment", "DEFAULT_TRUE")
@@ -513,7 +513,7 @@ def test_identify_engagement_edges_from_the_bench(tmp_path):
     """issue 12: `identify film` on engagement runs and `identify static` on breakaway runs, as the bench
     writes them (their index CSVs), recover the bench's phi and static factor within 5 %; the film state
     cuts the transient error several-fold."""
-    from wetclutch import bench as bench_sim
+    from wetclutch.simulate import bench as bench_sim
     data = tmp_path / "data"
     bench_sim.run("engagement", data / "engagement", slips_rpm=[750.0], logs=False)
     bench_sim.run("breakaway", data / "breakaway")

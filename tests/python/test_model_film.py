@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wetclutch import bench, calibration
+from wetclutch import calibration
+from wetclutch.simulate import bench
 from wetclutch.reference import model
 from wetclutch.identify import friction
 

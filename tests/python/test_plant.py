@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from wetclutch import bench, plant
+from wetclutch.simulate import bench, plant
 
 RPM = plant.RPM
 DT = plant.DT_S

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from frames_check import assert_frames_match_reference
-from wetclutch import calibration, replay
+from wetclutch import calibration
+from wetclutch.hil import replay
 from wetclutch.util import canlog
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from vcan_support import needs_vcan
-from wetclutch import calibration, plant, shift
+from wetclutch import calibration, shift
+from wetclutch.simulate import plant
 from wetclutch.calibration import shift as shift_calibration
 from wetclutch.reference import model
 

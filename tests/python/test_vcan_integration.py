@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from frames_check import assert_frames_match_reference
-from wetclutch import replay
+from wetclutch.hil import replay
 from wetclutch.util import canlog
 
 STEPS = 800

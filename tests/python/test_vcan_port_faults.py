@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from vcan_support import needs_vcan
 
-from wetclutch import replay
+from wetclutch.hil import replay
 from wetclutch.util import canlog
 
 ROOT = Path(__file__).resolve().parents[2]

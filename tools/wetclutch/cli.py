@@ -82,7 +82,7 @@ def _cmd_vectors(args) -> int:
 
 
 def _cmd_replay(args) -> int:
-    from . import replay, report  # matplotlib and the CAN stack only when needed
+    from .hil import replay, report  # matplotlib and the CAN stack only when needed
     cal = calibration.load(args.calibration)
     out_root = Path(args.out)
     jobs = []
@@ -140,7 +140,7 @@ def _cmd_identify(args) -> int:
 
 def _cmd_bench(args) -> int:
     import time
-    from . import bench  # the simulator only when needed
+    from .simulate import bench  # the simulator only when needed
     start = time.monotonic()
     out = bench.run(args.experiment, args.out, true_path=args.true, seed=args.seed, slips_rpm=args.slip,
                     logs=True if args.logs else None, thetas_degC=args.theta)
@@ -165,7 +165,7 @@ _SKIPPED = {"error": "error frame(s)", "remote": "remote frame(s)", "fd": "CAN F
 
 
 def _cmd_film_study(args) -> int:
-    from . import film_study  # the bench simulator only when needed
+    from .studies import film_study  # the bench simulator only when needed
     res = film_study.run(Path(args.out), model_path=args.calibration, true_path=args.true, seed=args.seed)
     print(film_study.markdown(res))
     print(f"wrote {args.out}/film_study.md, film_study.json")
@@ -177,7 +177,8 @@ def _cmd_film_study(args) -> int:
 
 
 def _cmd_shift(args) -> int:
-    from . import plant, shift  # the plant and the closed loop only when needed
+    from . import shift  # the plant and the closed loop only when needed
+    from .simulate import plant
     try:
         plant.load_plant(args.plant)    # a bad plant file: one line naming it, before any work
     except plant.PlantError as e:
@@ -203,8 +204,8 @@ def _cmd_shift(args) -> int:
 
 
 def _cmd_convert(args) -> int:
-    from . import bench
-    stats = bench.convert_log(args.input, args.output, channel=args.channel)
+    from .hil import convert
+    stats = convert.convert_log(args.input, args.output, channel=args.channel)
     for where, stamp, previous in stats["out_of_order"][:5]:
         print(f"wetclutch convert: warning: {args.input}: {where}: timestamp {stamp:.6f} s is earlier than the"
               f" frame before it ({previous:.6f} s): out of order, copied as is", file=sys.stderr)

@@ -1,0 +1,8 @@
+"""Shared by every role, importing nothing else of wetclutch:
+
+atomic    output files written atomically (all or nothing)
+csvio     CSV in and out
+canlog    CAN frames by the DBC (hil/wetclutch.dbc) and candump -L logs
+errors    the errors the command line reports as one line
+plotting  matplotlib on the Agg backend: figures, style, saving
+"""

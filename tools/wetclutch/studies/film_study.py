@@ -18,13 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import bench, calibration
-from .reference import model
-from .util import atomic
-from .calibration import Calibration
-from .identify import edges
+from .. import calibration
+from ..calibration import Calibration
+from ..identify import edges
+from ..reference import model
+from ..simulate import bench
+from ..util import atomic
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFAULT_MODEL = ROOT / "tools" / "calibrations" / "bench_identified.toml"
 PHI_SCALES = (0.5, 1.0, 2.0)
 FIT_THETAS_DEGC = (40.0, 80.0)

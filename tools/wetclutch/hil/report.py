@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from . import replay
-from .reference import model
-from .util import atomic, canlog, plotting
-from .calibration import Calibration
+from ..reference import model
+from ..util import atomic, canlog, plotting
+from ..calibration import Calibration
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15
     "steady_rmse_Nm": {750: 2.25, 250: 2.98, 500: 3.03},

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .reference import model
-from .util import canlog
-from .calibration import Calibration
+from ..reference import model
+from ..util import canlog
+from ..calibration import Calibration
 
 ROOT = canlog.ROOT
 RX_NAMES = (canlog.SENSORS, canlog.REQUEST, canlog.BENCH)  # what wc_tcu's kernel filter lets in (--bench)

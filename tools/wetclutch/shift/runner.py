@@ -1,0 +1,178 @@
+"""One closed-loop shift and a scenario's shifts (run_case), the frames both ways, the double-precision
+reference on the TCU's inputs (reference_run), and the case on vcan (run_on_vcan)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+from ..calibration import shift as shift_calibration
+from ..reference import shift as shift_reference
+from ..simulate import plant as plant_mod
+from ..util import canlog
+from .quality import quality
+from .scenarios import NOMINAL, ROOT, SHIFT_TOML, TARGET_INERTIA_S, Scenario, ShiftError, scenario_matrix
+from .tcu import InprocTcu, VcanTcu
+
+
+def frame_sequence(records: list[dict]) -> list[tuple[int, str]]:
+    """The TCU's output frames of a case in order (id, hex), for the in-process / vcan comparison."""
+    return [(fid, data) for rec in records for _, fid, data in rec["frames"]]
+
+
+def run_on_vcan(out_dir: Path, shift_name: str = "shift_1_2_full", scenario_name: str = NOMINAL,
+                plant_path=plant_mod.DEFAULT_PLANT) -> Path:
+    """One closed-loop shift against wc_tcu on vcan0 (natively or in the QEMU guest, hil/vcan_run.sh);
+    writes out_dir/vcan_frames.json and returns its path."""
+    out_dir = Path(out_dir).resolve()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out_dir), "--",
+           str(ROOT / ".venv" / "bin" / "python"), "-m", "wetclutch.shift", "--vcan-guest", str(out_dir),
+           shift_name, scenario_name, str(plant_path)]
+    env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
+    result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
+    if result.returncode != 0:
+        raise ShiftError(f"closed-loop shift on vcan failed (exit {result.returncode}); see {out_dir}")
+    return out_dir / "vcan_frames.json"
+
+
+def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: str) -> int:
+    """Guest side of run_on_vcan: the case against wc_tcu on vcan0, frames and quality to JSON."""
+    sc = next(s for s in scenario_matrix() if s.name == scenario_name)
+    params = plant_mod.load_plant(plant_path)
+    tcu = VcanTcu(shift_name, sc.oil_degC, log_dir=Path(out_dir))
+    try:
+        recs = run_case(params, shift_name, sc, tcu=tcu)
+    finally:
+        tcu.close()
+    payload = {"frames": frame_sequence(recs), "quality": [quality(r) for r in recs]}
+    Path(out_dir, "vcan_frames.json").write_text(json.dumps(payload, default=float))
+    return 0
+
+
+def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s: float, seed: int,
+               target_s: float, shift_cal) -> dict:
+    """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record."""
+    p = params
+    full = p.turbine_torque_full * scenario.load
+    pl = plant_mod.UpshiftPlant(p, oil_degC=scenario.oil_degC, turbine_torque_Nm=full,
+                                friction_scale=p.friction_scale * scenario.friction_scale, seed=seed,
+                                theta_clutch_degC=theta_clutch_degC)
+    dt = pl.dt_s
+    n_pre = int(round(p.preroll_time / dt))
+    n = n_pre + int(round(p.shift_duration / dt))
+    msg_cmd = db.get_message_by_name(canlog.COMMAND)
+    msg_est = db.get_message_by_name(canlog.ESTIMATE)
+    msg_rep = db.get_message_by_name(canlog.SHIFT_REPORT)
+    rec = {k: np.empty(n) for k in ("t_s", "sensor_slip_rad_s", "current_mA", "pressure_command_Pa",
+                                    "theta_estimate_degC", "model_torque_Nm", "locked_tcu")}
+    truth = {}
+    frames_out = []
+    frames_in = []          # what the TCU received, for the reference (shift_reference.py)
+    report = None
+    current = 0.0
+    for k in range(n):
+        t = t0_s + k * dt
+        s = pl.sensors()
+        frames = [enc.frame(canlog.REQUEST, TorqueRequest=0.0, Mode=canlog.MODE_SHIFT),
+                  enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=int(k >= n_pre), TargetGear=2,
+                            TurbineTorque=float(np.clip(s["turbine_torque_estimate_Nm"], -1000.0, 1000.0)),
+                            TargetInertiaTime=round(target_s * 1e3)),
+                  enc.frame(canlog.SENSORS, SlipSpeed=float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
+                            OilTemp=float(s["oil_degC"]), HousingTemp=float(s["housing_degC"]))]
+        frames_in.append([(m.arbitration_id, bytes(m.data)) for m in frames])
+        out = tcu.exchange(t, frames)
+        for fid, data in out:
+            frames_out.append((k, fid, data.hex().upper()))
+            if fid == msg_cmd.frame_id:
+                c = msg_cmd.decode(data)
+                current = float(c["VfsCurrent"])
+                rec["current_mA"][k] = current
+                rec["pressure_command_Pa"][k] = float(c["PressureCommand"]) * 1e3
+                rec["locked_tcu"][k] = float(c["StatusLocked"])
+            elif fid == msg_est.frame_id:
+                e = msg_est.decode(data, decode_choices=False)
+                rec["theta_estimate_degC"][k] = float(e["EstimatedClutchTemp"])
+                rec["model_torque_Nm"][k] = float(e["ModelTorque"])
+            elif fid == msg_rep.frame_id:
+                report = msg_rep.decode(data, decode_choices=False)
+                report["step"] = k
+        rec["t_s"][k] = k * dt
+        rec["sensor_slip_rad_s"][k] = s["slip_rpm"] * plant_mod.RPM
+        pl.step(current, (k - n_pre) * dt if k >= n_pre else None)
+        for name, v in pl.truth.items():
+            truth.setdefault(name, np.empty(n))[k] = v
+    rec.update({f"true_{k}": v for k, v in truth.items()})
+    rec["frames"] = frames_out
+    rec["frames_in"] = frames_in
+    rec["report"] = report
+    rec["command_step"] = n_pre
+    n_prep = int(shift_cal.prepare_time / dt + 0.5)
+    n_tp = int(shift_cal.torque_phase_time / dt + 0.5)
+    k_i = n_pre + n_prep + n_tp           # the controller enters the inertia phase at this step (wc_shift.c)
+    rec["inertia_step"] = k_i
+    start = rec["sensor_slip_rad_s"][k_i]
+    ref = np.full(n, np.nan)
+    ref[k_i:] = [shift_reference.reference_slip(start, target_s, j * dt)[0] for j in range(n - k_i)]
+    rec["reference_slip_rad_s"] = ref
+    rec["end_theta_degC"] = float(truth["theta_clutch_degC"][-1])
+    return rec
+
+
+def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None = None, tcu=None,
+             target_s: float = TARGET_INERTIA_S, shift_cal=None) -> list[dict]:
+    """All shifts of a scenario (one, or the soak's back-to-back shifts with one TCU and the clutch
+    temperature carried over); returns one record per shift."""
+    shift_cal = shift_cal or shift_calibration.load(SHIFT_TOML).variants[shift_name.split("shift_1_2_")[-1]]
+    own = tcu is None
+    tcu = tcu or InprocTcu(shift_name, scenario.oil_degC, overrides)
+    try:
+        enc = canlog.Encoder()
+        db = enc.db
+        theta = None
+        t0 = 0.0
+        records = []
+        for i in range(scenario.shifts):
+            rec = _one_shift(params, tcu, enc, db, scenario, theta, t0, params.seed + i, target_s, shift_cal)
+            records.append(rec)
+            theta = rec["end_theta_degC"]
+            t0 += rec["t_s"][-1] + 1e-3
+        return records
+    finally:
+        if own:
+            tcu.close()
+
+
+def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float) -> dict:
+    """The double-precision reference (shift_reference.py) on the inputs the TCU received in rec, with the
+    TCU's safe state from its VfsCommand: per step the reference's current and the TCU's (decoded), and the
+    reports of both."""
+    db = canlog.database()
+    msgs = {n: db.get_message_by_name(n) for n in (canlog.SENSORS, canlog.SHIFT_COMMAND, canlog.COMMAND,
+                                                   canlog.SHIFT_REPORT)}
+    ids = {m.frame_id: n for n, m in msgs.items()}
+    ref = shift_reference.ShiftReference(shift_cal, clutch_cal, theta_start_degC)
+    n = len(rec["frames_in"])
+    out = {"reference_mA": np.empty(n), "tcu_mA": np.empty(n), "reference_report": None, "tcu_report": None,
+           "reference_report_step": None, "tcu_report_step": None}
+    outputs = {}
+    for k, fid, data in rec["frames"]:
+        outputs.setdefault(k, []).append((fid, bytes.fromhex(data)))
+    for k, frames in enumerate(rec["frames_in"]):
+        got = {ids[fid]: msgs[ids[fid]].decode(data, decode_choices=False) for fid, data in frames if fid in ids}
+        c, s = got[canlog.SHIFT_COMMAND], got[canlog.SENSORS]
+        tcu = {ids[fid]: msgs[ids[fid]].decode(data, decode_choices=False) for fid, data in outputs.get(k, []) if fid in ids}
+        vfs = tcu[canlog.COMMAND]
+        step_out, report = ref.step(bool(c["ShiftRequest"]), int(c["TargetGear"]), float(c["TurbineTorque"]),
+                                    float(c["TargetInertiaTime"]) * 1e-3, bool(vfs["StatusSafeStateActive"]),
+                                    float(s["SlipSpeed"]), float(s["OilTemp"]), float(s["HousingTemp"]))
+        out["reference_mA"][k] = step_out["current_mA"]
+        out["tcu_mA"][k] = float(vfs["VfsCurrent"])
+        if report is not None and out["reference_report"] is None:
+            out["reference_report"], out["reference_report_step"] = report, k
+        if canlog.SHIFT_REPORT in tcu and out["tcu_report"] is None:
+            out["tcu_report"], out["tcu_report_step"] = tcu[canlog.SHIFT_REPORT], k
+    return out

@@ -1,0 +1,104 @@
+"""The two TCUs a closed-loop shift runs against, the same firmware code: the frame loop in-process
+(InprocTcu, wc_replay --lockstep) and the TCU program on a SocketCAN interface (VcanTcu, wc_tcu)."""
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+from ..util import canlog
+from .scenarios import ROOT, TCU_CALIBRATION, WC_REPLAY, ShiftError
+
+
+class InprocTcu:
+    """The frame loop in-process: wc_replay --lockstep through a pipe."""
+
+    def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
+                 calibration: str = TCU_CALIBRATION, program: Path = WC_REPLAY):
+        if not Path(program).is_file():
+            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
+        cmd = [str(program), "-", "--lockstep", "--calibration", calibration, "--theta-start",
+               f"{theta_start_degC:.6g}", "--shift", shift_name]
+        for k, v in (overrides or {}).items():
+            cmd += ["--set", f"{k}={v:.9g}"]
+        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, bufsize=1)
+
+    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
+        lines = "".join(f"({t_s:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n" for m in frames)
+        try:
+            self.proc.stdin.write(lines)
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}") from None
+        out = []
+        while True:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}")
+            line = line.strip()
+            if line == ".":
+                return out
+            ident, data = line.split()[2].split("#")
+            out.append((int(ident, 16), bytes.fromhex(data)))
+
+    def close(self):
+        if self.proc.stdin:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=10)
+        self.proc.stdout.close()
+        self.proc.stderr.close()
+
+
+class VcanTcu:
+    """The TCU program on a SocketCAN interface: wc_tcu --clock frame --shift NAME, frames through python-can.
+    Each exchange sends the period's frames and returns what the TCU sent up to its ClutchEstimate (a
+    ShiftReport, sent after it, comes with the next exchange: the frame sequence is the same as in-process)."""
+
+    def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
+                 calibration: str = TCU_CALIBRATION, iface: str = "vcan0", log_dir: Path | None = None):
+        import can
+        if overrides:
+            raise ShiftError("wc_tcu takes compiled-in shift calibrations only (no overrides)")
+        program = ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
+        if not program.is_file():
+            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
+        db = canlog.database()
+        self.ids = {db.get_message_by_name(n).frame_id for n in (canlog.COMMAND, canlog.ESTIMATE, canlog.SHIFT_REPORT)}
+        self.estimate_id = db.get_message_by_name(canlog.ESTIMATE).frame_id
+        self.bus = can.Bus(interface="socketcan", channel=iface,
+                           can_filters=[{"can_id": i, "can_mask": 0x7FF, "extended": False} for i in sorted(self.ids)])
+        self.log = Path(log_dir or ".") / "wc_tcu_shift.txt"
+        self.log_file = open(self.log, "w")
+        self.proc = subprocess.Popen([str(program), "--iface", iface, "--clock", "frame", "--calibration", calibration,
+                                      "--shift", shift_name, "--theta-start", f"{theta_start_degC:.6g}"],
+                                     stdout=subprocess.DEVNULL, stderr=self.log_file)
+        import time
+        for _ in range(200):
+            if "clock frame" in self.log.read_text() or self.proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        if self.proc.poll() is not None or "clock frame" not in self.log.read_text():
+            raise ShiftError(f"wc_tcu did not start: {self.log.read_text().strip()}")
+
+    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
+        for m in frames:
+            self.bus.send(m)
+        out = []
+        while True:
+            msg = self.bus.recv(timeout=10.0)
+            if msg is None:
+                raise ShiftError(f"no answer from wc_tcu at t = {t_s:.3f} s: {self.log.read_text().strip()[-400:]}")
+            if msg.arbitration_id not in self.ids or msg.is_error_frame:
+                continue
+            out.append((msg.arbitration_id, bytes(msg.data)))
+            if msg.arbitration_id == self.estimate_id:
+                return out
+
+    def close(self):
+        import signal
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            self.proc.wait(timeout=10)
+        finally:
+            self.bus.shutdown()
+            self.log_file.close()
