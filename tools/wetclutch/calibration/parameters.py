@@ -2,6 +2,7 @@
 parameter table of the file (section, name, unit, constraint, C field), the firmware's limits and ranges."""
 from __future__ import annotations
 
+import functools
 import math
 import struct
 from dataclasses import dataclass
@@ -193,7 +194,7 @@ class Calibration:
         lining = self.friction_area * self.lining_thickness * self.lining_density * self.lining_specific_heat
         return self.friction_pairs * (separator + lining)
 
-    @property
+    @functools.cached_property   # a Calibration is immutable; the film's bisections read it ~10^6 times
     def roughness_parameter(self) -> float:
         """N beta sigma, dimensionless (Greenwood-Williamson)."""
         return self.asperity_density * self.asperity_tip_radius * self.roughness_rms

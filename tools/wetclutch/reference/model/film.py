@@ -40,9 +40,28 @@ def film_slope_m_per_Pa(cal: Calibration, separation_m):
     return -(1.0 + erf(x)) / (math.pi * enb * erfc(x))
 
 
+_SCALAR_CACHE_SIZE = 4096
+
+
 def separation_from_pressure_m(cal: Calibration, pressure_Pa):
-    """Inverse of eq. 15 by vectorized bisection (p_c is strictly decreasing in h)."""
+    """Inverse of eq. 15 by vectorized bisection (p_c is strictly decreasing in h).
+
+    A single pressure's answer is remembered per calibration (a Calibration is immutable, the
+    bisection a pure function of p): the step-by-step references ask for the same few pressures
+    (the film at zero force, at F_max, at the knee) every step."""
     p = np.asarray(pressure_Pa, dtype=float)
+    if p.size == 1:
+        cache = cal.__dict__.setdefault("_separation_of_pressure", {})
+        key = float(p.reshape(-1)[0])
+        if key not in cache:
+            if len(cache) >= _SCALAR_CACHE_SIZE:
+                cache.clear()
+            cache[key] = float(_separation_bisection(cal, np.array([key]))[0])
+        return np.full(p.shape, cache[key])
+    return _separation_bisection(cal, p)
+
+
+def _separation_bisection(cal: Calibration, p: np.ndarray):
     s = cal.roughness_rms
     lo = np.full(p.shape, -60.0 * s)
     hi = np.full(p.shape, 60.0 * s)
