@@ -31,9 +31,9 @@
  * Shift control (DESIGN 10) is measured over a realistic trajectory instead
  * of the grid: one 1->2 upshift (turbine torque 100 Nm, slip 100 rad/s at the
  * inertia phase's start, target 0.5 s, oil 80 degC) on the reduced plant of
- * tests/c/test_shift.c (I_t d(slip)/dt = a (T_t - a T_c), the turbine held
+ * tests/c/wc_test_fixtures.h (I_t d(slip)/dt = a (T_t - a T_c), the turbine held
  * until the inertia phase, the output side fixed), with the shift
- * calibration of that test (lag compensation 15 ms, observer temperature).
+ * calibration of the shift tests (lag compensation 15 ms, observer temperature).
  * Every step that starts in the inertia phase is a sample:
  *   wc_shift_step:inertia       wc_shift_step (clutch step with the lag
  *                               compensation included);
@@ -62,6 +62,7 @@
 #include "wc_arm_calibration.h"
 #include "wc_arm_io.h"
 #include "wc_arm_naive.h"
+#include "wc_test_fixtures.h"  /* tests/c: the shift scenario of the C tests */
 
 #ifndef WC_ARM_BENCH_LEVEL
 #define WC_ARM_BENCH_LEVEL unknown
@@ -547,39 +548,16 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
 /* ------------------------------------------------------------------------ */
 /* Shift control over one upshift (DESIGN 10)                               */
 
-#define SHIFT_TURBINE_TORQUE_Nm 100.0f
-#define SHIFT_START_SLIP_rad_s 100.0f
-#define SHIFT_TARGET_TIME_s 0.5f
-#define SHIFT_OIL_degC 80.0f
+#define SHIFT_TURBINE_TORQUE_Nm WC_TEST_SHIFT_TURBINE_TORQUE_Nm
+#define SHIFT_START_SLIP_rad_s WC_TEST_SHIFT_START_SLIP_rad_s
+#define SHIFT_TARGET_TIME_s WC_TEST_SHIFT_TARGET_TIME_s
+#define SHIFT_OIL_degC WC_TEST_SHIFT_OIL_degC
 #define SHIFT_MAX_PERIODS 3000u
 
-/* tests/c/test_shift.c's calibration. */
-static const wc_shift_calibration_t shift_calibration = {
-    .turbine_inertia_kg_m2 = 0.25f,
-    .turbine_ratio = 1.0f,
-    .output_inertia_kg_m2 = 1e5f,
-    .output_ratio = 1.0f,
-    .jerk_per_torque_rate = 0.01f,
-    .prepare_time_s = 0.05f,
-    .torque_phase_time_s = 0.1f,
-    .inertia_time_min_s = 0.1f,
-    .inertia_time_max_s = 2.0f,
-    .inertia_timeout_factor = 1.5f,
-    .lockup_ramp_time_s = 0.05f,
-    .holding_torque_factor = 1.3f,
-    .min_start_slip_rad_s = 5.0f,
-    .feedforward_gain = 1.0f,
-    .kp_Nm_per_rad_s = 2.0f,
-    .ki_Nm_per_rad = 40.0f,
-    .integral_limit_Nm = 300.0f,
-    .lag_compensation_time_s = 0.015f,
-    .theta_source = (uint32_t)WC_SHIFT_THETA_OBSERVER,
-    .flare_slip_rad_s = 10.0f,
-    .tie_up_factor = 1.5f,
-    .jerk_filter_time_s = 0.02f,
-};
+/* The C tests' shift calibration (tests/c/wc_test_fixtures.h). */
+static const wc_shift_calibration_t shift_calibration = WC_TEST_SHIFT_CALIBRATION;
 
-/* The plant of tests/c/test_shift.c: the turbine held by the off-going clutch
+/* The plant of tests/c/wc_test_fixtures.h (the shift tests' too): the turbine held by the off-going clutch
  * until the inertia phase, then I_t d(slip)/dt = a (T_t - a T_c); the plates
  * stick at zero slip and while the model is locked. */
 typedef struct {
@@ -591,12 +569,8 @@ static void plant_advance(shift_plant_t *p, uint32_t phase, const wc_step_output
 {
     if (phase == (uint32_t)WC_SHIFT_INERTIA) { p->released = true; }
     if (!p->released) { return; }
-    const float a = shift_calibration.turbine_ratio;
-    const float accel = a * (SHIFT_TURBINE_TORQUE_Nm - a * out->model.torque_Nm) / shift_calibration.turbine_inertia_kg_m2;
-    float next = p->slip_rad_s + accel * wc_arm_calibration->control_period_s;
-    if ((p->slip_rad_s >= 0.0f) && (next < 0.0f)) { next = 0.0f; }
-    if ((out->status & WC_STATUS_LOCKED) != 0u) { next = 0.0f; }
-    p->slip_rad_s = fminf(next, 1000.0f);
+    p->slip_rad_s = wc_test_shift_plant_slip_rad_s(&shift_calibration, p->slip_rad_s, SHIFT_TURBINE_TORQUE_Nm, out,
+                                                   wc_arm_calibration->control_period_s);
 }
 
 static wc_shift_t shift;
@@ -649,17 +623,17 @@ static void bench_shift_step(const wc_calibration_t *cal, row_t row)
 /* ClutchSensors, TorqueRequest (Mode 3 Shift) and ShiftCommand of one period. */
 static void queue_shift_frames(float slip_rad_s, bool shift_request, uint8_t alive)
 {
-    const wc_can_clutch_sensors_phys_t sensors = {slip_rad_s / WC_RAD_S_PER_RPM, SHIFT_OIL_degC, SHIFT_OIL_degC, alive};
-    const wc_can_torque_request_phys_t request = {0.0f, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, alive};
-    const wc_can_shift_command_phys_t command = {shift_request ? 1.0f : 0.0f, 2.0f, SHIFT_TURBINE_TORQUE_Nm, SHIFT_TARGET_TIME_s * 1000.0f, alive};
-    wc_can_frame_t frame = {WC_CAN_CLUTCH_SENSORS_FRAME_ID, 8u, 0u, {0u}};
-    if (wc_can_encode_clutch_sensors(frame.data, &sensors, sizeof frame.data) != WC_CAN_OK) { fail("shift: sensors frame"); }
+    wc_can_frame_t frame;
+    if (wc_test_shift_sensors_frame(&frame, slip_rad_s, alive) != WC_CAN_OK) { fail("shift: sensors frame"); }
     (void)wc_loop_receive(&loop, &frame);
-    frame.id = WC_CAN_TORQUE_REQUEST_FRAME_ID;
-    if (wc_can_encode_torque_request(frame.data, &request, sizeof frame.data) != WC_CAN_OK) { fail("shift: request frame"); }
+    if (wc_test_shift_request_frame(&frame, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, alive) != WC_CAN_OK) {
+        fail("shift: request frame");
+    }
     (void)wc_loop_receive(&loop, &frame);
-    frame.id = WC_CAN_SHIFT_COMMAND_FRAME_ID;
-    if (wc_can_encode_shift_command(frame.data, &command, sizeof frame.data) != WC_CAN_OK) { fail("shift: command frame"); }
+    if (wc_test_shift_command_frame(&frame, shift_request, SHIFT_TURBINE_TORQUE_Nm, SHIFT_TARGET_TIME_s * 1000.0f,
+                                    alive) != WC_CAN_OK) {
+        fail("shift: command frame");
+    }
     (void)wc_loop_receive(&loop, &frame);
 }
 
@@ -667,7 +641,7 @@ static void queue_shift_frames(float slip_rad_s, bool shift_request, uint8_t ali
  * calibration. ShiftRequest is 0 until the loop has left its safe state (E2E
  * sync, recovery_periods), then 1: a rising edge outside the safe state
  * starts the shift. Every step that starts in the inertia phase is a sample. */
-#define SHIFT_LOOP_SETTLE_PERIODS 40u
+#define SHIFT_LOOP_SETTLE_PERIODS WC_TEST_SHIFT_LOOP_SETTLE_PERIODS
 static void bench_loop_shift(const wc_calibration_t *cal, row_t row)
 {
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
