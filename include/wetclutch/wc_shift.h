@@ -201,16 +201,18 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
 
 /* One control period while the frame loop is in shift mode and not in its
  * safe state (safe = true: the loop's safe state is active; a running shift
- * aborts with WC_SHIFT_ABORT_INPUT_LOST). Builds the clutch input from
- * sensors (slip and temperatures; mode and request are the controller's),
- * steps the clutch (wc_clutch_step) and updates the quality vector. Returns
- * true when the shift ended this step; *report then holds its quality vector.
+ * aborts with WC_SHIFT_ABORT_INPUT_LOST). in holds the sensors (slip,
+ * temperatures, bench); the controller writes the rest of the clutch input in
+ * place (mode, torque request, carried torque, lag compensation, temperature
+ * source: on return in is the input the clutch stepped with), steps the
+ * clutch (wc_clutch_step) and updates the quality vector. Returns true when
+ * the shift ended this step; *report then holds its quality vector.
  * out must hold the previous step's output (zero-initialised before the
  * first): its WC_STATUS_SATURATED stops the integral (anti-windup). A request
  * bit already 1 when the safe state ends starts no shift: a new 0 -> 1 edge
  * is needed (no restart without the VCU's consent). */
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                   bool safe, wc_clutch_t *clutch, const wc_step_input_t *sensors, wc_step_output_t *out,
+                   bool safe, wc_clutch_t *clutch, wc_step_input_t *in, wc_step_output_t *out,
                    wc_shift_report_t *report);
 
 #endif /* WC_SHIFT_H */

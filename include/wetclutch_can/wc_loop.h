@@ -136,6 +136,8 @@ typedef struct {
     uint8_t tx_alive;
     wc_loop_counters_t counters;
     wc_step_output_t last;                  /* last step's model output */
+    wc_step_input_t input;                  /* last step's clutch input (in Shift mode as the controller set it) */
+    wc_shift_command_t command;             /* last Shift-mode step's command to the shift controller */
 } wc_loop_t;
 
 /* Validate the calibration (and the shift calibration: a failing one returns

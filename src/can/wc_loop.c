@@ -273,13 +273,21 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 
 }
 
-uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+/* What prepare() found for the model step and finish(), with this period's
+ * status bits (bits 0..15, WC_CAN_STATUS_*) in one word. */
+#define STEP_SHIFT (1uL << 16)   /* the shift controller steps the clutch */
+#define STEP_SAFE (1uL << 17)    /* the safe state is active */
+#define STEP_REPORT (1uL << 18)  /* a shift ended: ShiftReport */
+/* prepare() sets the clutch input field by field: all eleven of them (a new field fails here). */
+WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 11u * 4u, the_loop_sets_every_field_of_the_clutch_input);
+WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_bits_below_the_step_flags);
+
+/* The frames of this period, the inputs' freshness and the safe state, then
+ * the clutch input (loop->input) and in Shift mode the shift command
+ * (loop->command). Apart from the step so that its locals are not on the
+ * stack while the model runs. */
+static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
 {
-    WC_ASSERT((loop != NULL) && (out != NULL));
-    WC_ASSERT((loop == NULL) || (loop->clutch.model.cal != NULL));  /* initialised, and its init succeeded */
-    if ((loop == NULL) || (out == NULL)) { return 0u; }
-    /* With asserts off an uninitialised loop still answers: the clutch step
-     * gives 0 mA and WC_STATUS_NOT_INITIALISED, sent as the safe state. */
     /* Consumer side of the ring: writes only rx_head. The frames queued when
      * the step starts are this period's; one arriving meanwhile waits for the
      * next step (its slot is not released before then). */
@@ -298,23 +306,23 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
         loop->overflows_seen = overflows;
         loop->pending_status = (uint16_t)(loop->pending_status | WC_CAN_STATUS_FRAME_LOST);
     }
-    uint16_t bits = loop->pending_status;
+    uint32_t step = loop->pending_status;
     loop->pending_status = 0u;
     if (update_freshness(&loop->sensors_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts)) {
-        bits |= WC_CAN_STATUS_SENSOR_TIMEOUT;
+        step |= WC_CAN_STATUS_SENSOR_TIMEOUT;
     }
     if (update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
-        bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
+        step |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
     /* Shift mode: ShiftCommand is a control input too (its staleness counts as the request's). */
     const bool shift_mode = (loop->config.shift != NULL) && (loop->request.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE);
     if ((loop->config.shift != NULL) &&
         update_freshness(&loop->shift_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts) &&
         shift_mode) {
-        bits |= WC_CAN_STATUS_REQUEST_TIMEOUT;
+        step |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
     /* Debounce: both control inputs fresh for recovery_periods in a row. */
-    const bool fresh = (bits & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
+    const bool fresh = (step & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
     loop->fresh_periods = fresh ? ((loop->fresh_periods < UINT32_MAX) ? loop->fresh_periods + 1u : UINT32_MAX) : 0u;
     const bool safe = !fresh || (loop->fresh_periods < loop->config.recovery_periods);
     uint32_t bench_timeouts = 0u;  /* bench frames are optional: staleness is not a fault */
@@ -322,15 +330,24 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
                              !update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
     const float load_cell_N = loop->bench.load_cell_force_N;
 
-    const wc_step_input_t in = {
-        .slip_rad_s = loop->sensors.slip_speed_rpm * WC_RAD_S_PER_RPM,
-        .theta_oil_degC = loop->sensors.oil_temp_degC,
-        .theta_housing_degC = loop->sensors.housing_temp_degC,
-        .torque_request_Nm = loop->request.torque_request_Nm,
-        .mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode),
-        .bench = { bench_fresh, (load_cell_N > 0.0f) ? load_cell_N : 0.0f, loop->bench.measured_torque_Nm },
-    };
-    bool report = false;
+    /* the clutch input, field by field into the loop (no copy of a whole struct) */
+    wc_step_input_t *in = &loop->input;
+    in->slip_rad_s = loop->sensors.slip_speed_rpm * WC_RAD_S_PER_RPM;
+    in->theta_oil_degC = loop->sensors.oil_temp_degC;
+    in->theta_housing_degC = loop->sensors.housing_temp_degC;
+    in->torque_request_Nm = loop->request.torque_request_Nm;
+    in->mode = safe ? WC_MODE_OPEN : mode_of(loop->request.mode);
+    in->bench.valid = bench_fresh;
+    in->bench.apply_force_N = (load_cell_N > 0.0f) ? load_cell_N : 0.0f;
+    in->bench.torque_Nm = loop->bench.measured_torque_Nm;
+    in->lag_compensation_time_s = 0.0f;
+    in->theta_from_oil = false;
+    in->carried_torque_Nm = 0.0f;
+    if (bench_fresh) { step |= WC_CAN_STATUS_BENCH_INPUT; }
+    if (safe) {
+        step |= WC_CAN_STATUS_SAFE_STATE_ACTIVE | STEP_SAFE;
+        loop->counters.safe_steps++;
+    }
     const bool shift_running = wc_shift_phase_running(loop->shift.phase);
     if (!shift_mode && !shift_running && (loop->shift.phase != (uint32_t)WC_SHIFT_IDLE)) {
         wc_shift_init(&loop->shift);  /* a finished shift ends with its mode: the new mode acts now */
@@ -344,24 +361,49 @@ uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
             .turbine_torque_Nm = c->turbine_torque_Nm,
             .target_inertia_time_s = c->target_inertia_time_ms * 1.0e-3f,
         };
-        report = wc_shift_step(&loop->shift, loop->config.shift, &command, safe, &loop->clutch, &in, &loop->last,
-                               &loop->report);
-        bits |= status_bits(loop->last.status);
-    } else {
-        bits |= status_bits(wc_clutch_step(&loop->clutch, &in, &loop->last));
+        loop->command = command;
+        step |= STEP_SHIFT;
     }
-    if (bench_fresh) { bits |= WC_CAN_STATUS_BENCH_INPUT; }
-    if (safe) {
-        bits |= WC_CAN_STATUS_SAFE_STATE_ACTIVE;
-        loop->counters.safe_steps++;
-    }
+    return step;
+}
 
-    encode_outputs(loop, bits, out);
+/* After the model: the model's status bits, the output frames, the counters. */
+static uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
-    if (report) { encode_report(&loop->report, &out[n++]); }
+    if ((step & STEP_REPORT) != 0u) { encode_report(&loop->report, &out[n++]); }
     loop->counters.steps++;
     loop->counters.frames_out += n;
     return n;
+}
+
+/* Queue frame (NULL: none), then when step_now one control period. */
+static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bool step_now,
+                                wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    if (frame != NULL) { (void)wc_loop_receive(loop, frame); }  /* a refusal is counted (WC_REJECT_OVERFLOW) */
+    if (!step_now) { return 0u; }
+    WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
+    uint32_t step = prepare(loop);
+    if ((step & STEP_SHIFT) != 0u) {
+        if (wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u, &loop->clutch,
+                          &loop->input, &loop->last, &loop->report)) {
+            step |= STEP_REPORT;
+        }
+    } else {
+        (void)wc_clutch_step(&loop->clutch, &loop->input, &loop->last);  /* its status is loop->last.status */
+    }
+    return finish(loop, step, out);
+}
+
+uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+{
+    WC_ASSERT((loop != NULL) && (out != NULL));
+    if ((loop == NULL) || (out == NULL)) { return 0u; }
+    /* With asserts off an uninitialised loop still answers: the clutch step
+     * gives 0 mA and WC_STATUS_NOT_INITIALISED, sent as the safe state. */
+    return run(loop, NULL, true, out);
 }
 
 uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
@@ -369,13 +411,9 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
 {
     WC_ASSERT((loop != NULL) && (out != NULL));
     if ((loop == NULL) || (out == NULL)) { return 0u; }
-    bool step_now = tick;
-    if (frame != NULL) {
-        (void)wc_loop_receive(loop, frame);  /* a refusal is counted (WC_REJECT_OVERFLOW) */
-        step_now = step_now || ((clock == WC_LOOP_CLOCK_FRAME) && (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) &&
-                                (frame->flags == 0u));
-    }
-    return step_now ? wc_loop_step(loop, out) : 0u;
+    const bool step_now = tick || ((frame != NULL) && (clock == WC_LOOP_CLOCK_FRAME) &&
+                                   (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
+    return run(loop, frame, step_now, out);
 }
 
 uint32_t wc_loop_rx_ids(const wc_loop_config_t *config, uint32_t ids[WC_LOOP_RX_ID_COUNT])

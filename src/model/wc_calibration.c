@@ -193,6 +193,14 @@ static wc_cal_error_t check_relations(const wc_calibration_t *cal)
     return WC_CAL_OK;
 }
 
+/* The film table's rules in the order they are reported (as
+ * calibration.film_problem applies them: each rule over the whole table
+ * before the next). One pass over the nodes collects the rules that fail,
+ * the first of them is reported. */
+#define FILM_AXIS (1u << 0)          /* WC_CAL_FILM_AXIS_NOT_MONOTONE */
+#define FILM_RANGE (1u << 1)         /* WC_CAL_FILM_RANGE */
+#define FILM_NOT_MONOTONE (1u << 2)  /* WC_CAL_FILM_NOT_MONOTONE */
+
 static wc_cal_error_t check_film(const wc_calibration_t *cal)
 {
     const wc_film_table_t *t = &cal->film;
@@ -204,30 +212,29 @@ static wc_cal_error_t check_film(const wc_calibration_t *cal)
     const float *h = t->hbar_m;
     const float *s = t->slope_m_per_Pa;
     const uint32_t n = t->length;
-    /* Each loop is bounded by WC_FILM_MAX_NODES (n <= it, checked above); one
-     * rule at a time over the whole table, as calibration.film_problem does. */
+    uint32_t failed = (p[0] >= 0.0f) ? 0u : FILM_RANGE;  /* a contact pressure is not negative */
+    /* Bounded by WC_FILM_MAX_NODES (n <= it, checked above). */
     for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
+        /* a non-finite entry is the first rule: reported whatever else fails */
         if (!isfinite(p[i]) || !isfinite(h[i]) || !isfinite(s[i])) { return WC_CAL_FILM_TABLE; }
+        if ((i > 0u) && !(p[i] > p[i - 1u])) { failed |= FILM_AXIS; }
+        if (!within(h[i], WC_CAL_LIMIT_FILM_HBAR_MIN_m, WC_CAL_LIMIT_FILM_HBAR_MAX_m)) { failed |= FILM_RANGE; }
+        if (!(s[i] <= 0.0f)) { failed |= FILM_NOT_MONOTONE; }  /* h_bar falls as p_c rises */
+        if (i + 1u < n) {
+            const float delta = (h[i + 1u] - h[i]) / (p[i + 1u] - p[i]);
+            /* the data strictly decreasing, and Fritsch-Carlson: alpha, beta >= 0
+             * (slopes <= 0, delta < 0) and alpha^2 + beta^2 <= 9: the cubic
+             * Hermite on the interval is monotone */
+            const float alpha = s[i] / delta;
+            const float beta = s[i + 1u] / delta;
+            if (!(delta < 0.0f) || !(alpha * alpha + beta * beta <= WC_CAL_LIMIT_FRITSCH_CARLSON)) {
+                failed |= FILM_NOT_MONOTONE;
+            }
+        }
     }
-    for (uint32_t i = 1u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
-        if (!(p[i] > p[i - 1u])) { return WC_CAL_FILM_AXIS_NOT_MONOTONE; }
-    }
-    if (!(p[0] >= 0.0f)) { return WC_CAL_FILM_RANGE; }  /* a contact pressure is not negative */
-    for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
-        if (!within(h[i], WC_CAL_LIMIT_FILM_HBAR_MIN_m, WC_CAL_LIMIT_FILM_HBAR_MAX_m)) { return WC_CAL_FILM_RANGE; }
-    }
-    for (uint32_t i = 0u; (i < WC_FILM_MAX_NODES) && (i < n); ++i) {
-        if (!(s[i] <= 0.0f)) { return WC_CAL_FILM_NOT_MONOTONE; }  /* h_bar falls as p_c rises */
-    }
-    for (uint32_t k = 0u; (k < WC_FILM_MAX_NODES) && (k + 1u < n); ++k) {
-        const float delta = (h[k + 1u] - h[k]) / (p[k + 1u] - p[k]);
-        if (!(delta < 0.0f)) { return WC_CAL_FILM_NOT_MONOTONE; }  /* the data strictly decreasing */
-        /* Fritsch-Carlson: alpha, beta >= 0 (slopes <= 0, delta < 0) and
-         * alpha^2 + beta^2 <= 9: the cubic Hermite on the interval is monotone. */
-        const float alpha = s[k] / delta;
-        const float beta = s[k + 1u] / delta;
-        if (!(alpha * alpha + beta * beta <= WC_CAL_LIMIT_FRITSCH_CARLSON)) { return WC_CAL_FILM_NOT_MONOTONE; }
-    }
+    if ((failed & FILM_AXIS) != 0u) { return WC_CAL_FILM_AXIS_NOT_MONOTONE; }
+    if ((failed & FILM_RANGE) != 0u) { return WC_CAL_FILM_RANGE; }
+    if (failed != 0u) { return WC_CAL_FILM_NOT_MONOTONE; }
     /* The table reaches the contact pressure at the maximum current (the force
      * wc_model_init derives); beyond its last node the film is held constant. */
     const float force_max_N =

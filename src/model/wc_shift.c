@@ -81,16 +81,39 @@ float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float
     return start_slip_rad_s * (1.0f - x * x * (3.0f - 2.0f * x));
 }
 
-float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2)
+/* The driveline model's terms of the feed-forward (DESIGN 10), once per
+ * step for both of its uses (the inertia phase's feed-forward and the torque
+ * the clutch carries once synchronous). */
+typedef struct {
+    float drive_rad_s2;          /* a T_t / I_t */
+    float inverse_inertia;       /* a^2 / I_t + b^2 / I_out, 1 / (kg m^2) */
+} wc_driveline_t;
+
+static wc_driveline_t driveline(const wc_shift_calibration_t *cal, float turbine_torque_Nm)
 {
     /* DESIGN 10: T_ff = (a T_t / I_t + b T_s / I_o - dref/dt) / (a^2 / I_t + b^2 / I_o),
      * stiff driveshaft: I_o -> I_out (output shaft + vehicle), T_s -> road load ~ 0 */
     const float a = cal->turbine_ratio;
     const float b = cal->output_ratio;
     const float i_t = cal->turbine_inertia_kg_m2;
-    const float t_ff = (a * turbine_torque_Nm / i_t - reference_rate_rad_s2) /
-                       (a * a / i_t + b * b / cal->output_inertia_kg_m2);
-    return (t_ff > 0.0f) ? ((t_ff < WC_TORQUE_MAX_Nm) ? t_ff : WC_TORQUE_MAX_Nm) : 0.0f;
+    const wc_driveline_t d = { a * turbine_torque_Nm / i_t, a * a / i_t + b * b / cal->output_inertia_kg_m2 };
+    return d;
+}
+
+static float clamp_torque_Nm(float torque_Nm)
+{
+    return (torque_Nm > 0.0f) ? ((torque_Nm < WC_TORQUE_MAX_Nm) ? torque_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
+}
+
+static float feedforward_Nm(const wc_driveline_t *d, float reference_rate_rad_s2)
+{
+    return clamp_torque_Nm((d->drive_rad_s2 - reference_rate_rad_s2) / d->inverse_inertia);
+}
+
+float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2)
+{
+    const wc_driveline_t d = driveline(cal, turbine_torque_Nm);
+    return feedforward_Nm(&d, reference_rate_rad_s2);
 }
 
 static uint32_t periods_of(float time_s, float dt_s)
@@ -98,7 +121,6 @@ static uint32_t periods_of(float time_s, float dt_s)
     const float n = time_s / dt_s + 0.5f;  /* both checked: time <= 10 s, dt >= 1e-4 s */
     return (uint32_t)n;
 }
-
 
 static void enter(wc_shift_t *shift, wc_shift_phase_t phase)
 {
@@ -130,9 +152,25 @@ static void start(wc_shift_t *shift, const wc_shift_command_t *command, float sl
     enter(shift, WC_SHIFT_PREPARE);
 }
 
-/* The torque request of this period (the phase's law); may change the phase. */
+/* The clutch's control period (the fallback only for a clutch whose init failed). */
+static float period_s(const wc_clutch_t *clutch)
+{
+    return (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;
+}
+
+/* The slip the controller uses: the measured one, or while it is invalid the
+ * clutch's last valid one. The same before and after the clutch step: the
+ * step holds only a valid slip (wc_clutch_step, 1.). */
+static float control_slip_rad_s(const wc_clutch_t *clutch, const wc_step_input_t *in)
+{
+    return wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
+}
+
+/* The torque request of this period (the phase's law); may change the phase.
+ * d: the driveline terms of this step, carried_Nm the feed-forward at a zero
+ * slip rate. */
 static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s,
-                              float dt_s, bool saturated)
+                              float dt_s, bool saturated, const wc_driveline_t *d, float carried_Nm)
 {
     const float share_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;  /* T_t / a */
     if (shift->phase == (uint32_t)WC_SHIFT_PREPARE) {
@@ -148,7 +186,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
          * the integral takes what the feed-forward does not give of the last request */
         enter(shift, WC_SHIFT_INERTIA);
         shift->start_slip_rad_s = slip_rad_s;
-        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, 0.0f);
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * carried_Nm;
         if (!(slip_rad_s > cal->min_start_slip_rad_s)) {
             abort_shift(shift, WC_SHIFT_ABORT_NO_SLIP);
             return 0.0f;
@@ -158,7 +196,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s;
         const float reference = wc_shift_reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
-        const float ff_Nm = cal->feedforward_gain * wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, rate_rad_s2);
+        const float ff_Nm = cal->feedforward_gain * feedforward_Nm(d, rate_rad_s2);
         const float error = slip_rad_s - reference;  /* slip above the reference: more torque */
         shift->error_sq_sum += error * error;
         shift->inertia_periods++;
@@ -185,22 +223,19 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     return cal->holding_torque_factor * share_Nm;
 }
 
-bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                   bool safe, wc_clutch_t *clutch, const wc_step_input_t *sensors, wc_step_output_t *out,
-                   wc_shift_report_t *report)
+/* Before the clutch step: the transitions on the command and the loop's
+ * state, then the clutch input (in place: mode, request, carried torque, lag
+ * compensation, temperature source). Apart from wc_shift_step so that its
+ * locals are not on the stack while the clutch steps. */
+static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal,
+                                     const wc_shift_command_t *command, bool safe, const wc_clutch_t *clutch,
+                                     wc_step_input_t *in, const wc_step_output_t *last)
 {
-    WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (sensors != NULL) &&
-              (out != NULL) && (report != NULL));
-    if ((shift == NULL) || (cal == NULL) || (command == NULL) || (clutch == NULL) || (sensors == NULL) ||
-        (out == NULL) || (report == NULL)) {
-        return false;
-    }
-    const uint32_t phase_before = shift->phase;
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
-    const float dt_s = (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;
-    const float slip_rad_s = wc_slip_valid(sensors->slip_rad_s) ? sensors->slip_rad_s : clutch->held.slip_rad_s;
-    const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
+    const float dt_s = period_s(clutch);
+    const float slip_rad_s = control_slip_rad_s(clutch, in);
+    const bool saturated = (last->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
 
     /* Transitions on the command and the loop's state. */
     if (safe || !command->request) {
@@ -222,28 +257,35 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
 
-    wc_step_input_t in = *sensors;
-    in.mode = WC_MODE_OPEN;
-    in.torque_request_Nm = 0.0f;
-    in.carried_torque_Nm = 0.0f;
-    in.lag_compensation_time_s = cal->lag_compensation_time_s;
-    in.theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
+    in->mode = WC_MODE_OPEN;
+    in->torque_request_Nm = 0.0f;
+    in->carried_torque_Nm = 0.0f;
+    in->lag_compensation_time_s = cal->lag_compensation_time_s;
+    in->theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
     if (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
-        float request_Nm = phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated);
-        request_Nm = (request_Nm > 0.0f) ? ((request_Nm < WC_TORQUE_MAX_Nm) ? request_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
+        const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
+        /* once synchronous the clutch carries what the driveline model says
+         * (the feed-forward at a zero slip rate), not the request */
+        const float carried_Nm = feedforward_Nm(&d, 0.0f);
+        const float request_Nm = clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm));
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
-            in.mode = WC_MODE_TORQUE;
-            in.torque_request_Nm = request_Nm;
+            in->mode = WC_MODE_TORQUE;
+            in->torque_request_Nm = request_Nm;
             shift->request_Nm = request_Nm;
-            /* once synchronous the clutch carries what the driveline model says
-             * (the feed-forward at a zero slip rate), not the request */
-            in.carried_torque_Nm = wc_shift_feedforward_Nm(cal, shift->turbine_torque_Nm, 0.0f);
+            in->carried_torque_Nm = carried_Nm;
         }
     }
-    (void)wc_clutch_step(clutch, &in, out);
-    const uint32_t phase_stepped = shift->phase;
+}
 
-    /* After the step: the lock-up decides the inertia phase's end. */
+/* After the clutch step: the lock-up decides the inertia phase's end, the
+ * quality vector, the report. Returns true when the shift ended. */
+static bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
+                                    const wc_step_input_t *in, const wc_step_output_t *out, wc_shift_report_t *report,
+                                    uint32_t phase_before)
+{
+    const uint32_t phase_stepped = shift->phase;
+    const float dt_s = period_s(clutch);
+    const float slip_rad_s = control_slip_rad_s(clutch, in);
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
@@ -298,4 +340,20 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         *report = shift->report;
     }
     return ended;
+}
+
+bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                   bool safe, wc_clutch_t *clutch, wc_step_input_t *in, wc_step_output_t *out,
+                   wc_shift_report_t *report)
+{
+    WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (in != NULL) &&
+              (out != NULL) && (report != NULL));
+    if ((shift == NULL) || (cal == NULL) || (command == NULL) || (clutch == NULL) || (in == NULL) ||
+        (out == NULL) || (report == NULL)) {
+        return false;
+    }
+    const uint32_t phase_before = shift->phase;
+    shift_before(shift, cal, command, safe, clutch, in, out);
+    (void)wc_clutch_step(clutch, in, out);
+    return shift_after(shift, cal, clutch, in, out, report, phase_before);
 }
