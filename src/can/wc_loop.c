@@ -118,7 +118,7 @@ WC_STATIC_ASSERT((WC_E2E_STATUS_OK < WC_E2E_STATUS_SYNC) && (WC_E2E_STATUS_OKSOM
 WC_STATIC_ASSERT((WC_CAN_SATURATED < WC_CAN_ERR_NAN) && (WC_CAN_ERR_NAN < WC_CAN_ERR_RANGE), can_errors_come_last);
 
 /* Map a decode result and (for E2E frames) the alive counter to use / reject. */
-static bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, bool e2e, uint8_t alive)
+WC_INLINE_HOT bool accept(wc_loop_t *loop, wc_loop_input_t *in, wc_can_result_t decoded, bool e2e, uint8_t alive)
 {
     if (decoded == WC_CAN_ERR_SIZE) { reject(loop, WC_REJECT_SHORT); return false; }
     if (decoded == WC_CAN_ERR_CRC) { reject(loop, WC_REJECT_CRC); return false; }

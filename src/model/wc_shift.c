@@ -68,7 +68,8 @@ void wc_shift_init(wc_shift_t *shift)
     *shift = idle;
 }
 
-float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
+/* Inline in the step at -O2 (no call, no rate through memory); the public function is the same code. */
+WC_INLINE_HOT float reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
 {
     /* DESIGN 10: smoothstep from the start slip to 0; zero slope at both ends,
      * so the feed-forward (and the clutch torque) neither steps at the phase
@@ -79,6 +80,11 @@ float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float
         *rate_rad_s2 = (target_time_s > 0.0f) ? (-6.0f * start_slip_rad_s * x * (1.0f - x) / target_time_s) : 0.0f;
     }
     return start_slip_rad_s * (1.0f - x * x * (3.0f - 2.0f * x));
+}
+
+float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
+{
+    return reference_slip(start_slip_rad_s, target_time_s, elapsed_s, rate_rad_s2);
 }
 
 /* The driveline model's terms of the feed-forward (DESIGN 10), once per
@@ -152,20 +158,6 @@ static void start(wc_shift_t *shift, const wc_shift_command_t *command, float sl
     enter(shift, WC_SHIFT_PREPARE);
 }
 
-/* The clutch's control period (the fallback only for a clutch whose init failed). */
-static float period_s(const wc_clutch_t *clutch)
-{
-    return (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;
-}
-
-/* The slip the controller uses: the measured one, or while it is invalid the
- * clutch's last valid one. The same before and after the clutch step: the
- * step holds only a valid slip (wc_clutch_step, 1.). */
-static float control_slip_rad_s(const wc_clutch_t *clutch, const wc_step_input_t *in)
-{
-    return wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
-}
-
 /* The torque request of this period (the phase's law); may change the phase.
  * d: the driveline terms of this step, carried_Nm the feed-forward at a zero
  * slip rate. */
@@ -195,7 +187,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s;
-        const float reference = wc_shift_reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float reference = reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
         const float ff_Nm = cal->feedforward_gain * feedforward_Nm(d, rate_rad_s2);
         const float error = slip_rad_s - reference;  /* slip above the reference: more torque */
         shift->error_sq_sum += error * error;
@@ -225,17 +217,12 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
 
 /* Before the clutch step: the transitions on the command and the loop's
  * state, then the clutch input (in place: mode, request, carried torque, lag
- * compensation, temperature source). Apart from wc_shift_step so that its
- * locals are not on the stack while the clutch steps. */
-static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal,
-                                     const wc_shift_command_t *command, bool safe, const wc_clutch_t *clutch,
-                                     wc_step_input_t *in, const wc_step_output_t *last)
+ * compensation, temperature source). saturated: the last step's output was. */
+static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                         bool safe, bool saturated, float slip_rad_s, float dt_s, wc_step_input_t *in)
 {
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
-    const float dt_s = period_s(clutch);
-    const float slip_rad_s = control_slip_rad_s(clutch, in);
-    const bool saturated = (last->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
 
     /* Transitions on the command and the loop's state. */
     if (safe || !command->request) {
@@ -280,12 +267,10 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal,
 /* After the clutch step: the lock-up decides the inertia phase's end, the
  * quality vector, the report. Returns true when the shift ended. */
 static bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
-                                    const wc_step_input_t *in, const wc_step_output_t *out, wc_shift_report_t *report,
-                                    uint32_t phase_before)
+                        const wc_step_output_t *out, wc_shift_report_t *report, uint32_t phase_before,
+                        float slip_rad_s, float dt_s)
 {
     const uint32_t phase_stepped = shift->phase;
-    const float dt_s = period_s(clutch);
-    const float slip_rad_s = control_slip_rad_s(clutch, in);
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
@@ -353,7 +338,11 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         return false;
     }
     const uint32_t phase_before = shift->phase;
-    shift_before(shift, cal, command, safe, clutch, in, out);
+    const float dt_s = (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;  /* init failed: any */
+    /* the measured slip, or while it is invalid the clutch's last valid one */
+    const float slip_rad_s = wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
+    const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
+    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, in);
     (void)wc_clutch_step(clutch, in, out);
-    return shift_after(shift, cal, clutch, in, out, report, phase_before);
+    return shift_after(shift, cal, clutch, out, report, phase_before, slip_rad_s, dt_s);
 }
