@@ -80,13 +80,14 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ti
  * as a first-order approach of time t would, from F_app = F_c(h_bar) +
  * D mu_v (-dh_bar/dt) / h_bar^3 with dh_bar/dt = (h_bar* - h_bar) / t; never
  * below the wanted force (the steady command), at most F_max. The piston
- * pressure of that force, as a current, goes to lead_lag. contact_N is the
- * asperity force F_c(h_bar) of the film state. */
-static void lead_film(const wc_model_t *model, float hbar_m, float contact_N, float viscosity_Pa_s, float time_s,
+ * pressure of that force, as a current, goes to lead_lag. contact_Pa is the
+ * asperity pressure p_c(h_bar) of the film state. */
+static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, float viscosity_Pa_s, float time_s,
                       uint32_t film_segment, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
     if (!(model->film_damping_m4 > 0.0f) || !(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return; }
+    const float contact_N = cal->friction_area_m2 * contact_Pa;
     /* the inverse found the force on film_segment: the lookup starts there */
     const float target_hbar_m = wc_film_hbar_near_m(&cal->film, inv->force_N / cal->friction_area_m2, film_segment);
     if (!(hbar_m > target_hbar_m)) { return; }  /* at or past the wanted film: the steady force */
@@ -142,10 +143,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
-    const float film_contact_N = model->cal->friction_area_m2 * contact.pressure_Pa;
     const bool lead = (in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f);
     if (lead) {
-        lead_film(model, hbar_m, film_contact_N, point.viscosity_Pa_s, in->lag_compensation_time_s, film_segment, &inv);
+        lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, in->lag_compensation_time_s, film_segment,
+                  &inv);
     }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv); }
@@ -174,14 +175,14 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (film) {
         /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
          * squeeze film carries the rest, and the film advances under the force. */
-        wc_torque_at_film(&point, signed_slip_rad_s, film_contact_N, hbar_m, &out->model);
-        out->contact_force_N = film_contact_N;
+        const float contact_N = cal->friction_area_m2 * contact.pressure_Pa;
+        wc_torque_at_film(&point, signed_slip_rad_s, contact_N, hbar_m, &out->model);
+        out->contact_force_N = contact_N;
         clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
                                                    model->film_damping_m4 * point.viscosity_Pa_s,
                                                    cal->control_period_s, film_segment);
     } else {
-        /* eq. 16: the paper's steady film */
-        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, film_segment, &out->model);
+        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
         out->contact_force_N = force_N;
     }
 

@@ -134,7 +134,6 @@ wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t
     const wc_film_table_t *film = &cal->film;
     wc_status_t status = WC_STATUS_OK;
     out->iterations = 0u;
-    *film_segment = WC_FILM_NO_SEGMENT;
 
     /* At F_c = 0 the film is the table's first (thickest, clamped) node. */
     if (torque_request_Nm * film->hbar_m[0] <= point->viscous_Nm_m) {
@@ -224,6 +223,6 @@ wc_status_t wc_inverse(const wc_model_t *model, float slip_rad_s, float theta_de
     }
     wc_torque_point_t point;
     wc_torque_point(model, slip_rad_s, theta_degC, &point);
-    uint32_t film_segment;
+    uint32_t film_segment = WC_FILM_NO_SEGMENT;
     return wc_inverse_at_point(model, &point, torque_request_Nm, out, &film_segment);
 }

@@ -24,16 +24,15 @@ typedef struct {
 /* mu_f, mu_v at a valid (slip, theta). */
 void wc_torque_point(const wc_model_t *model, float slip_rad_s, float theta_degC, wc_torque_point_t *point);
 
-/* eq. 5-8 at the point for a valid force_N, signed with the slip; the film
- * table's segment `film_segment` is tried first (wc_film_hbar_near_m:
- * the same torque whatever it is; WC_FILM_NO_SEGMENT: none known). */
+/* eq. 5-8 at the point for a valid force_N, signed with the slip. */
 void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
-                        uint32_t film_segment, wc_torque_t *out);
+                        wc_torque_t *out);
 
 /* The inverse at the point for a valid torque_request_Nm (wc_inverse.h).
- * *film_segment: the film table's segment that holds the force found, for
- * the lookups that follow at nearby forces; WC_FILM_NO_SEGMENT when the force
- * was not solved on a segment (below drag, saturated, outside the table). */
+ * *film_segment: set to the film table's segment that holds the force found
+ * when the force was solved on a segment, for the lookup of that force's film
+ * (the lead's); left as it is (the caller's WC_FILM_NO_SEGMENT) when it was
+ * not (below drag, saturated, outside the table). */
 wc_status_t wc_inverse_at_point(const wc_model_t *model, const wc_torque_point_t *point, float torque_request_Nm,
                                 wc_inverse_t *out, uint32_t *film_segment);
 

@@ -32,10 +32,12 @@ static void wc_torque_rejected(const wc_model_t *model, wc_torque_t *out)
 }
 
 void wc_torque_at_point(const wc_model_t *model, const wc_torque_point_t *point, float slip_rad_s, float force_N,
-                        uint32_t film_segment, wc_torque_t *out)
+                        wc_torque_t *out)
 {
-    /* eq. 16: steady film, p_c = F_c / A_f (the table passed the calibration check at init) */
-    const float hbar_m = wc_film_hbar_near_m(&model->cal->film, force_N / model->cal->friction_area_m2, film_segment);
+    /* eq. 16: steady film, p_c = F_c / A_f (the table passed the calibration check at init; the
+     * modelled force lags the commanded one: no segment to start from that would hold in the worst case) */
+    const float hbar_m = wc_film_hbar_near_m(&model->cal->film, force_N / model->cal->friction_area_m2,
+                                             WC_FILM_NO_SEGMENT);
     wc_torque_at_film(point, slip_rad_s, force_N, hbar_m, out);
 }
 
@@ -61,6 +63,6 @@ wc_status_t wc_torque(const wc_model_t *model, float slip_rad_s, float theta_deg
     }
     wc_torque_point_t point;
     wc_torque_point(model, slip_rad_s, theta_degC, &point);
-    wc_torque_at_point(model, &point, slip_rad_s, force_N, WC_FILM_NO_SEGMENT, out);
+    wc_torque_at_point(model, &point, slip_rad_s, force_N, out);
     return WC_STATUS_OK;
 }
