@@ -378,7 +378,9 @@ static uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOO
     return n;
 }
 
-/* Queue frame (NULL: none), then when step_now one control period. */
+/* Queue frame (NULL: none), then when step_now one control period. The one
+ * routine behind wc_loop_step and wc_loop_iterate, which tail-call it: on the
+ * deepest stack chain (Shift mode) only this frame lies above the model's. */
 static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bool step_now,
                                 wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
