@@ -139,12 +139,6 @@ static void add_viscosity_term(float a, float b, float *low, float *high)
     *high += larger(at_min, at_max);
 }
 
-/* The temperature factor of eq. 18, written as wc_friction_coefficient computes it. */
-static float friction_temperature_factor(const wc_calibration_t *cal, float theta_degC)
-{
-    return 1.0f + cal->mu3 * (theta_degC - cal->theta1_degC) / cal->theta2_K;
-}
-
 /* The rules between fields, each after the last field it involves. */
 static wc_cal_error_t check_relations(const wc_calibration_t *cal)
 {
@@ -160,9 +154,10 @@ static wc_cal_error_t check_relations(const wc_calibration_t *cal)
     add_viscosity_term(cal->viscosity_a2_Pa_s, cal->viscosity_b2_per_K, &low, &high);
     if (!(low > 0.0f) || !(high <= WC_CAL_LIMIT_VISCOSITY_MAX_Pa_s)) { return WC_CAL_VISCOSITY_RANGE; }
 
-    /* linear in theta: positive on the domain iff positive at both ends */
-    const float at_min = friction_temperature_factor(cal, WC_THETA_MIN_degC);
-    const float at_max = friction_temperature_factor(cal, WC_THETA_MAX_degC);
+    /* the temperature factor of eq. 18 as the model computes it; linear in
+     * theta: positive on the domain iff positive at both ends */
+    const float at_min = wc_friction_temperature_factor(cal, WC_THETA_MIN_degC);
+    const float at_max = wc_friction_temperature_factor(cal, WC_THETA_MAX_degC);
     if (!(at_min > 0.0f) || !(at_max > 0.0f) ||
         !(larger(cal->mu1, cal->mu2) * larger(at_min, at_max) <= WC_CAL_LIMIT_MU_MAX)) {
         return WC_CAL_FRICTION_DOMAIN;
