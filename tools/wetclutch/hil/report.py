@@ -219,8 +219,7 @@ def _torque_plot(cal: Calibration, s: Series, m: dict, out_dir: Path) -> str:
                    legend={"fontsize": 8, "loc": "lower left"})
     b.plot(s.t_s, s.torque_model_Nm - s.torque_meas_Nm, lw=0.8, color="C0", label="TCU − measured")
     b.plot(s.t_s, steady - s.torque_meas_Nm, lw=0.8, color="C1", ls="--", label="steady model − measured")
-    b.set_ylim(-60, 60)
-    plotting.style(b, "time [s]", "error [Nm]", legend={"fontsize": 7, "loc": "lower right"})
+    plotting.style(b, "time [s]", "error [Nm]", legend={"fontsize": 7, "loc": "upper right"})
     return plotting.save(fig, out_dir / "torque.png")
 
 

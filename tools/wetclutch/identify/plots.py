@@ -87,6 +87,7 @@ def _fig11a(v: _MuView, out_dir: Path) -> str:
             ax.plot(v.vgrid, model.friction_coefficient(cal, cal.effective_radius * v.vgrid * RAD_S_PER_RPM, th),
                     "k-", lw=0.8)
         ax.set_xlim(0, xmax)
+        plotting.fit_y_to_x(ax)   # the Stribeck detail: the samples below 30 rpm, not all of them
         plotting.style(ax, "slip speed (rpm)", "mu_f (eq. 17)")
     axs[0].set_title(f"Fig. 11a: mu_f vs slip ({v.pick.size} of {v.r['mu_samples'].size} samples),"
                      " eq. 18 at 20..100 °C")
@@ -135,8 +136,9 @@ def _fig12(v: _MuView, out_dir: Path) -> str:
     ax = f.add_subplot(1, 2, 2)
     fit_cells = model.friction_coefficient(cal, cal.effective_radius * g["slip_rpm"] * RAD_S_PER_RPM,
                                            g["theta_degC"])
-    sc = ax.scatter(g["slip_rpm"], g["theta_degC"], c=g["mu"] - fit_cells, cmap="RdBu_r", s=14,
-                    vmin=-0.004, vmax=0.004)
+    residual = g["mu"] - fit_cells
+    reach = float(np.nanmax(np.abs(residual)))   # the colour scale fitted to the residuals, centred on 0
+    sc = ax.scatter(g["slip_rpm"], g["theta_degC"], c=residual, cmap="RdBu_r", s=14, vmin=-reach, vmax=reach)
     plotting.style(ax, "slip (rpm)", "temperature (°C)",
                    f"cell mean - eq. 18 (grid R² {g['r2']:.4f}, RMSE {g['rmse']:.5f})", grid=None)
     f.colorbar(sc, ax=ax, label="mu_f residual")

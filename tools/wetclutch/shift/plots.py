@@ -55,5 +55,6 @@ def plot_case(path: Path, runs: dict, title: str) -> None:
                    title="clutch temperature: true (solid), TCU estimate (dashed)", legend={"fontsize": 7})
     for ax in axes.flat:
         ax.set_xlim(-0.05, 1.0)
+        plotting.fit_y_to_x(ax)   # the records run from the pre-roll to 1.5 s: fit what the window shows
     fig.suptitle(title)
     plotting.save(fig, path)
