@@ -1,4 +1,17 @@
-"""Command line: ``wetclutch {lut,reference,vectors,bench,convert,identify,replay,film-study,shift}``."""
+"""The wet-clutch tool's command line: parse, call one function of the package, print its result.
+
+commands by role (the folder of tools/wetclutch that does the work):
+  generate/   lut         calibration and h_bar(p_c) headers (a shift calibration: its header)
+              vectors     golden vectors for the C tests
+  reference/  reference   the double-precision model on CSV, under the firmware's input rules
+  simulate/   bench       the simulated test bench: measurement CSVs and CAN logs
+  identify/   identify    bench data -> calibration file
+  hil/        replay      bench logs to wc_tcu on vcan0, checked against the reference; the report
+              convert     a Vector ASC/BLF log -> candump -L
+  shift/      shift       closed-loop 1->2 upshifts on the plant (simulate/plant)
+  studies/    film-study  the squeeze-film state over a family of bench plants
+calibration/ (loading and checking calibration files) and util/ serve them all.
+"""
 from __future__ import annotations
 
 import argparse
@@ -220,7 +233,8 @@ def _cmd_convert(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="wetclutch", description=__doc__)
+    p = argparse.ArgumentParser(prog="wetclutch", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
     q = sub.add_parser("lut", help="write the calibration and h_bar(p_c) headers for the firmware")
