@@ -106,7 +106,7 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
     edges = {**ein, **eout, "hbar_um": eout["hbar_m"] * 1e6}
     text = (
         banner(command)
-        + f"/* Golden vectors from the double-precision reference (tools/wetclutch/model.py),\n"
+        + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
         f" * calibration {Path(cal.path).name}. Values rounded to 9 significant digits. */\n"
         "#ifndef WC_GOLDEN_VECTORS_H\n#define WC_GOLDEN_VECTORS_H\n\n"
         "typedef struct { double slip_rpm, theta_degC, force_N, torque_Nm, coulomb_Nm, viscous_Nm, hbar_um, mu_f; }"
