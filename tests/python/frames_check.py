@@ -1,5 +1,5 @@
 """The TCU's output frames against the double-precision reference of its loop
-(wetclutch.replay.loop_reference), step by step: shared by the vcan test and
+(wetclutch.hil.replay.loop_reference), step by step: shared by the vcan test and
 the in-process test, so both hold the firmware to the same tolerances."""
 from __future__ import annotations
 

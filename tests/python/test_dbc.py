@@ -55,7 +55,7 @@ UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", *STATUS_B
 
 
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
-    """The E2E CRC by the Python side (wetclutch.canlog, independent of the C code)."""
+    """The E2E CRC by the Python side (wetclutch.util.canlog, independent of the C code)."""
     return bytes(canlog.protect(frame_id, bytearray(data)))
 
 

@@ -6,7 +6,7 @@ thermal model of eq. 1 driven by the model torque, a first-order thermistor
 lag and Gaussian sensor noise. It is a reduced Table 2 (3 forces, short
 ramps, 100 Hz), so the whole file runs in well under 40 s.
 
-When the bench simulator (tools/wetclutch/bench.py) is present, one test runs
+When the bench simulator (tools/wetclutch/simulate/bench) is present, one test runs
 the full chain on a reduced subset of its Table 2 campaign; the full 184-run
 campaign is measured by test_full_campaign, which only runs with
 WC_IDENTIFY_FULL=1 (see its docstring).
@@ -450,7 +450,7 @@ def _bench_job(args):
     return kind
 
 
-@pytest.mark.skipif(_bench() is None, reason="bench simulator (tools/wetclutch/bench.py) not available")
+@pytest.mark.skipif(_bench() is None, reason="bench simulator (tools/wetclutch/simulate/bench) not available")
 def test_bench_chain_reduced_campaign(tmp_path):
     """The bench simulator's data through identify all and lut: 16 Table 2 runs (4 forces x 100/300 rpm x
     40/80 degC, 5 s loading) and the two thermal runs cut to 30 s. About 15 s."""

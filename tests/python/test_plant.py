@@ -1,4 +1,4 @@
-"""The 1->2 upshift plant (tools/wetclutch/plant.py, DESIGN 10): steady 1st gear, lock-up into 2nd,
+"""The 1->2 upshift plant (tools/wetclutch/simulate/plant, DESIGN 10): steady 1st gear, lock-up into 2nd,
 energy bookkeeping, the hydraulic lag, determinism, tie-up, flare, the true clutch against the bench's,
 and bad plant files."""
 from __future__ import annotations

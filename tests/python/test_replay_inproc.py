@@ -1,6 +1,6 @@
 """The TCU's frame loop in-process (src/host/wc_replay: the same wc_loop_iterate
 as wc_tcu --clock frame, without SocketCAN) against the double-precision
-reference of the loop (wetclutch.replay.loop_reference), on the bundled bench
+reference of the loop (wetclutch.hil.replay.loop_reference), on the bundled bench
 logs and on logs with injected faults. No VM: this is the fast check that the
 C loop and its Python reference implement the same policy (E2E receiver,
 debounce, bench input, status bits); the HIL replay repeats it on vcan.

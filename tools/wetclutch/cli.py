@@ -327,7 +327,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def os_error_text(e: OSError) -> str:
-    """'path: reason' (atomic.py names the final path of an output), or the reason alone where the OS
+    """'path: reason' (util/atomic.py names the final path of an output), or the reason alone where the OS
     named no file."""
     reason = e.strerror or str(e)
     if e.filename is None:

@@ -22,7 +22,7 @@ Rules read from the DBC (an unsupported signal is an error, not a guess):
                             raw value and what NaN encodes to; without SNA a
                             NaN encodes to raw 0, which must lie in [min|max]
 
-Usage: python -m wetclutch.can_descriptors DBC HEADER_OUT SOURCE_OUT
+Usage: python -m wetclutch.generate.can_descriptors DBC HEADER_OUT SOURCE_OUT
 """
 from __future__ import annotations
 
@@ -362,7 +362,7 @@ def generate(dbc_path: Path, header_out: Path, source_out: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     if len(args) != 3:
-        print("usage: python -m wetclutch.can_descriptors DBC HEADER_OUT SOURCE_OUT", file=sys.stderr)
+        print("usage: python -m wetclutch.generate.can_descriptors DBC HEADER_OUT SOURCE_OUT", file=sys.stderr)
         return 2
     try:
         generate(Path(args[0]), Path(args[1]), Path(args[2]))

@@ -14,7 +14,7 @@ index and measurement tables, through csvio), signals.py filters and
 segments each record and names every excluded sample, statistics.py holds the
 confidence intervals and fit figures, report.py and plots.py write report.md,
 figures.json, exclusions.csv and the PNGs, pipeline.py runs the steps and
-writes the outputs; the calibration file is rendered by calibration.py.
+writes the outputs; the calibration file is rendered by calibration/writer.py.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The ``reference`` subcommand: the model of model.py on CSV columns, under the firmware's input rules.
+"""The ``reference`` subcommand: the model of reference/model on CSV columns, under the firmware's input rules.
 
 Column names and units match the firmware's host program ``wc_eval`` so the
 two can be compared file against file.

@@ -2,7 +2,7 @@
 firmware's closed-loop frames are checked against (tests/python/test_shift.py).
 
 ShiftReference.step takes what the frame loop hands wc_shift_step (the decoded ShiftCommand, the loop's safe
-state, the sensor values) and steps its own ClutchReference (model.py), as the firmware steps its clutch.
+state, the sensor values) and steps its own ClutchReference (reference/model), as the firmware steps its clutch.
 """
 from __future__ import annotations
 

@@ -71,7 +71,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
                                     "theta_estimate_degC", "model_torque_Nm", "locked_tcu")}
     truth = {}
     frames_out = []
-    frames_in = []          # what the TCU received, for the reference (shift_reference.py)
+    frames_in = []          # what the TCU received, for the reference (reference/shift.py)
     report = None
     current = 0.0
     for k in range(n):
@@ -147,7 +147,7 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
 
 
 def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float) -> dict:
-    """The double-precision reference (shift_reference.py) on the inputs the TCU received in rec, with the
+    """The double-precision reference (reference/shift.py) on the inputs the TCU received in rec, with the
     TCU's safe state from its VfsCommand: per step the reference's current and the TCU's (decoded), and the
     reports of both."""
     db = canlog.database()

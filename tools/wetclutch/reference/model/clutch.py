@@ -38,7 +38,7 @@ class ClutchReference:
     (Lockup.torque_Nm), no heat and STATUS_LOCKED; observer advanced with |T dw| and kept in
     [THETA_MIN_DEGC, THETA_MAX_DEGC], STATUS_OVER_TEMPERATURE above THETA_OVER_DEGC until it falls
     THETA_OVER_HYSTERESIS_K below. theta_from_oil: the model takes the oil temperature (thermal-blind).
-    The inputs are taken as valid (the frame loop's reference, replay.py, holds invalid ones)."""
+    The inputs are taken as valid (the frame loop's reference, hil/replay.py, holds invalid ones)."""
 
     def __init__(self, cal: Calibration, theta_start_degC: float):
         self.cal = cal

@@ -26,7 +26,7 @@ STATUS_INPUT_INVALID = (STATUS_SLIP_INVALID | STATUS_THETA_INVALID | STATUS_FORC
                         | STATUS_POWER_INVALID)
 
 # The firmware's input ranges (include/wetclutch/wc_config.h; temperatures: THETA_MIN_DEGC, THETA_MAX_DEGC above),
-# checked in float32 as the firmware does (reference.py).
+# checked in float32 as the firmware does (reference/evaluate.py).
 SLIP_MAX_RAD_S = 1047.2           # WC_SLIP_MAX_rad_s: 10000 rpm
 FORCE_MAX_N = 1.0e5
 TORQUE_MAX_NM = 1.0e5
