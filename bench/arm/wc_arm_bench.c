@@ -493,7 +493,7 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
     if (wc_clutch_init(&clutch, wc_arm_identified_calibration, theta_degC) != WC_CAL_OK) {
         fail("wc_clutch_init (identified)");
     }
-    ctx.step_in.lag_compensation_time_s = FILM_LAG_TIME_s;
+    ctx.step_in.lag_compensation = wc_lag_compensation(&clutch, FILM_LAG_TIME_s);
     for (uint32_t k = 1u, next = 0u; next < FILM_LAG_SAMPLES_PER_POINT; ++k) {
         if (k == film_lag_steps[next]) {
             record(ROW_CLUTCH_STEP_FILM_LAG, measure(thunk_clutch_step, &ctx));
@@ -503,7 +503,7 @@ static void bench_point(float slip_rpm, float theta_degC, float fraction, worst_
             thunk_clutch_step(&ctx);
         }
     }
-    ctx.step_in.lag_compensation_time_s = 0.0f;
+    ctx.step_in.lag_compensation = wc_lag_compensation(&clutch, 0.0f);  /* off */
 
     /* wc_loop_step: both input frames queued every period, the 4th step measured. */
     /* The default configuration with a one-period recovery debounce, so that the

@@ -33,6 +33,14 @@ typedef struct {
     float torque_Nm;           /* torque sensor, signed like the slip */
 } wc_bench_input_t;
 
+/* Lag compensation (DESIGN 9), made by wc_lag_compensation() once per setting
+ * (its exponential is a per-shift constant, not a per-step one). Zero
+ * (zero-initialized): off. */
+typedef struct {
+    float time_s;    /* t of the lead, in (0, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s] when on */
+    float vfs_gain;  /* (1 - e^(-dt/t)) / (1 - e^(-dt/tau)): the VFS lag's inverse for t, > 0 when on */
+} wc_lag_compensation_t;
+
 typedef struct {
     float slip_rad_s;          /* clutch slip speed dw, signed */
     float theta_oil_degC;      /* oil (sump) temperature */
@@ -40,16 +48,17 @@ typedef struct {
     float torque_request_Nm;   /* wanted clutch torque, magnitude >= 0 (WC_MODE_TORQUE) */
     wc_clutch_mode_t mode;
     wc_bench_input_t bench;    /* zero-initialized: not on a bench */
-    /* Lag compensation (DESIGN 9): 0 (zero-initialized) commands the steady
+    /* Lag compensation (DESIGN 9): off (zero-initialized) commands the steady
      * current of the wanted force and leaves the squeeze film and the VFS lag
-     * (tau) to act; t > 0 (WC_MODE_TORQUE) leads both: with the film state on,
-     * the wanted apply force is raised so that the film approaches the wanted
-     * contact force's film with time constant t (never below the steady
-     * force), and the current leads the VFS lag so that the modelled pressure
-     * approaches that force's pressure with time constant t instead of tau;
-     * bounded to F_max and the solenoid's range. Not finite or negative: off,
-     * WC_STATUS_INPUT_INVALID not set. */
-    float lag_compensation_time_s;
+     * (tau) to act; on (wc_lag_compensation() of a t > 0, WC_MODE_TORQUE) leads
+     * both: with the film state on, the wanted apply force is raised so that
+     * the film approaches the wanted contact force's film with time constant t
+     * (never below the steady force), and the current leads the VFS lag so
+     * that the modelled pressure approaches that force's pressure with time
+     * constant t instead of tau; bounded to F_max and the solenoid's range.
+     * A time outside (0, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s] or a gain that
+     * is not finite and positive: off, WC_STATUS_INPUT_INVALID not set. */
+    wc_lag_compensation_t lag_compensation;
     /* true: the model (inverse and torque) takes the oil temperature instead of
      * the observer's estimate (a thermal-blind model, for comparisons); the
      * observer keeps running. */
@@ -105,7 +114,7 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  *  2. WC_MODE_TORQUE: inverse at the current temperature estimate (or the oil
  *     temperature, theta_from_oil) -> current command (a locked clutch: the
  *     force that holds the request with the holding margin), then led ahead
- *     of the VFS lag when lag_compensation_time_s > 0; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
+ *     of the VFS lag when the lag compensation is on; WC_MODE_OPEN / WC_MODE_LOCKED: the solenoid's minimum /
  *     maximum current (an unknown mode counts as WC_MODE_OPEN and is flagged
  *     WC_STATUS_TORQUE_INVALID);
  *  3. VFS lag -> modelled pressure -> apply force (on a bench: the measured
@@ -127,5 +136,11 @@ wc_cal_error_t wc_clutch_init(wc_clutch_t *clutch, const wc_calibration_t *cal, 
  * violation: WC_ASSERT, and with asserts off zero outputs (0 mA) and
  * WC_STATUS_NOT_INITIALISED. */
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out);
+
+/* The lag compensation of time constant time_s for this clutch's calibration
+ * (DESIGN 9), for wc_step_input_t.lag_compensation: computed once, used every
+ * step. time_s outside (0, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s] (NaN
+ * included), or a clutch whose init failed: off (zeros). NULL: WC_ASSERT, off. */
+wc_lag_compensation_t wc_lag_compensation(const wc_clutch_t *clutch, float time_s);
 
 #endif /* WC_CLUTCH_H */

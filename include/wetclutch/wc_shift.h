@@ -90,7 +90,7 @@ typedef struct {
     float kp_Nm_per_rad_s;             /* PI on the slip error (slip - reference) */
     float ki_Nm_per_rad;
     float integral_limit_Nm;           /* |integral term| bound (anti-windup) */
-    float lag_compensation_time_s;     /* wc_step_input_t.lag_compensation_time_s; 0: off */
+    float lag_compensation_time_s;     /* t of wc_lag_compensation() for wc_step_input_t; 0: off */
     uint32_t theta_source;             /* wc_shift_theta_source_t */
     /* Quality */
     float flare_slip_rad_s;            /* slip above the slip at inertia start + this: flare */
@@ -176,6 +176,7 @@ typedef struct {
     float error_sq_sum;            /* sum of squared slip errors over the inertia phase, (rad/s)^2 */
     uint32_t inertia_periods;
     uint32_t band_periods;         /* consecutive periods with the slip inside the lock band */
+    wc_lag_compensation_t lag_compensation;  /* of the calibration's time, made at the shift's start */
     wc_shift_report_t report;      /* running, final at the end */
 } wc_shift_t;
 

@@ -279,7 +279,7 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 #define STEP_SAFE (1uL << 17)    /* the safe state is active */
 #define STEP_REPORT (1uL << 18)  /* a shift ended: ShiftReport */
 /* prepare() sets the clutch input field by field: all eleven of them (a new field fails here). */
-WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 11u * 4u, the_loop_sets_every_field_of_the_clutch_input);
+WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 12u * 4u, the_loop_sets_every_field_of_the_clutch_input);
 WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_bits_below_the_step_flags);
 
 /* The frames of this period, the inputs' freshness and the safe state, then
@@ -340,7 +340,8 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     in->bench.valid = bench_fresh;
     in->bench.apply_force_N = (load_cell_N > 0.0f) ? load_cell_N : 0.0f;
     in->bench.torque_Nm = loop->bench.measured_torque_Nm;
-    in->lag_compensation_time_s = 0.0f;
+    in->lag_compensation.time_s = 0.0f;
+    in->lag_compensation.vfs_gain = 0.0f;
     in->theta_from_oil = false;
     in->carried_torque_Nm = 0.0f;
     if (bench_fresh) { step |= WC_CAN_STATUS_BENCH_INPUT; }

@@ -1,5 +1,6 @@
 #include "wetclutch/wc_clutch.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -55,13 +56,12 @@ static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *
  * the wanted P* as a lag of time constant t would, P' = P + (P* - P)(1 - e^(-dt/t)),
  * the current must be K i = P + (P* - P)(1 - e^(-dt/t)) / (1 - d): a bounded
  * inverse of the lag, the current clamped to the solenoid's range. t >= tau
- * asks for no lead (the factor <= 1 is kept: a slower, smoother approach). */
-static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float time_s, wc_inverse_t *inv)
+ * asks for no lead (the factor <= 1 is kept: a slower, smoother approach).
+ * The factor is wc_lag_compensation_t.vfs_gain (wc_lag_compensation). */
+static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float gain, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
-    if (!(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return WC_STATUS_OK; }  /* also NaN: off */
     const float wanted_Pa = cal->vfs_gain_Pa_per_mA * inv->current_mA;
-    const float gain = (1.0f - wc_exp(-cal->control_period_s / time_s)) / (1.0f - model->vfs_decay);
     const float current_mA = (pressure_Pa + (wanted_Pa - pressure_Pa) * gain) / cal->vfs_gain_Pa_per_mA;
     if (current_mA > cal->vfs_current_max_mA) {
         inv->current_mA = cal->vfs_current_max_mA;
@@ -86,7 +86,7 @@ static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, f
                       uint32_t film_segment, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
-    if (!(model->film_damping_m4 > 0.0f) || !(time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s)) { return; }
+    if (!(model->film_damping_m4 > 0.0f)) { return; }  /* time_s: in range (the caller's check) */
     const float contact_N = cal->friction_area_m2 * contact_Pa;
     /* the inverse found the force on film_segment: the lookup starts there */
     const float target_hbar_m = wc_film_hbar_near_m(&cal->film, inv->force_N / cal->friction_area_m2, film_segment);
@@ -143,13 +143,13 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
-    const bool lead = (in->mode == WC_MODE_TORQUE) && (in->lag_compensation_time_s > 0.0f);
-    if (lead) {
-        lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, in->lag_compensation_time_s, film_segment,
-                  &inv);
-    }
+    const wc_lag_compensation_t *lag = &in->lag_compensation;
+    const bool lead = (in->mode == WC_MODE_TORQUE) && (lag->time_s > 0.0f) &&
+                      (lag->time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s) && (lag->vfs_gain > 0.0f) &&
+                      (lag->vfs_gain <= FLT_MAX);  /* also NaN: off */
+    if (lead) { lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, lag->time_s, film_segment, &inv); }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
-    if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, in->lag_compensation_time_s, &inv); }
+    if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, lag->vfs_gain, &inv); }
     out->current_mA = inv.current_mA;
     out->force_command_N = inv.force_N;
     out->inverse_iterations = inv.iterations;
@@ -213,4 +213,20 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (clutch->over_temperature) { status |= WC_STATUS_OVER_TEMPERATURE; }
     out->status = status;
     return status;
+}
+
+wc_lag_compensation_t wc_lag_compensation(const wc_clutch_t *clutch, float time_s)
+{
+    WC_ASSERT(clutch != NULL);
+    wc_lag_compensation_t lag = { 0.0f, 0.0f };  /* off; also for a clutch whose init failed (no calibration) */
+    if ((clutch == NULL) || (clutch->model.cal == NULL) ||
+        !((time_s > 0.0f) && (time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s))) {
+        return lag;
+    }
+    /* DESIGN 9, lead_lag: the factor (1 - e^(-dt/t)) / (1 - d), d = e^(-dt/tau); finite and > 0 for
+     * t in (0, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s] (dt and tau checked by the calibration check) */
+    const wc_model_t *model = &clutch->model;
+    lag.time_s = time_s;
+    lag.vfs_gain = (1.0f - wc_exp(-model->cal->control_period_s / time_s)) / (1.0f - model->vfs_decay);
+    return lag;
 }

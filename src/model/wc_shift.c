@@ -64,7 +64,7 @@ void wc_shift_init(wc_shift_t *shift)
     WC_ASSERT(shift != NULL);
     if (shift == NULL) { return; }
     static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u, 0u,
-                                     { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u } };
+                                     { 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u } };
     *shift = idle;
 }
 
@@ -147,9 +147,11 @@ static bool command_valid(const wc_shift_calibration_t *cal, const wc_shift_comm
            in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm);
 }
 
-static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s)
+static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s,
+                  const wc_lag_compensation_t *lag)
 {
     wc_shift_init(shift);
+    shift->lag_compensation = *lag;  /* its exponential once per shift, not per step */
     shift->last_request = true;
     shift->turbine_torque_Nm = command->turbine_torque_Nm;
     shift->target_time_s = command->target_inertia_time_s;
@@ -219,7 +221,8 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
  * state, then the clutch input (in place: mode, request, carried torque, lag
  * compensation, temperature source). saturated: the last step's output was. */
 static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                         bool safe, bool saturated, float slip_rad_s, float dt_s, wc_step_input_t *in)
+                         bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
+                         wc_step_input_t *in)
 {
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
@@ -233,7 +236,8 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
         if (command_valid(cal, command)) {
-            start(shift, command, slip_rad_s);
+            const wc_lag_compensation_t lag = wc_lag_compensation(clutch, cal->lag_compensation_time_s);
+            start(shift, command, slip_rad_s, &lag);
         } else {  /* nothing of the command is kept (it may hold NaN) */
             wc_shift_init(shift);
             shift->last_request = true;
@@ -247,7 +251,7 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
     in->mode = WC_MODE_OPEN;
     in->torque_request_Nm = 0.0f;
     in->carried_torque_Nm = 0.0f;
-    in->lag_compensation_time_s = cal->lag_compensation_time_s;
+    in->lag_compensation = shift->lag_compensation;
     in->theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
     if (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
         const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
@@ -342,7 +346,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     /* the measured slip, or while it is invalid the clutch's last valid one */
     const float slip_rad_s = wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
     const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
-    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, in);
+    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, in);
     (void)wc_clutch_step(clutch, in, out);
     return shift_after(shift, cal, clutch, out, report, phase_before, slip_rad_s, dt_s);
 }

@@ -1,8 +1,9 @@
 /* What the shift controller asks of wc_clutch_step (include/wetclutch/wc_clutch.h;
  * DESIGN section 10): the VFS lag compensation and the thermal-blind option.
  *
- *  - lag compensation: faster pressure, current bounded and flagged, and off
- *    (0, NaN, negative, inf) bit for bit the uncompensated step;
+ *  - lag compensation: faster pressure, current bounded and flagged, off
+ *    (0, NaN, negative, inf; a hand-filled time or gain out of range) bit for
+ *    bit the uncompensated step, made once by wc_lag_compensation;
  *  - theta_from_oil: the model at the oil temperature, the observer running. */
 #include "wc_test_shift_harness.h"
 
@@ -14,7 +15,7 @@
 /* Lag compensation and theta_from_oil (wc_clutch_step)                      */
 /* ======================================================================== */
 
-static wc_step_input_t torque_input(float slip_rad_s, float request_Nm, float lag_s)
+static wc_step_input_t torque_input(const wc_clutch_t *clutch, float slip_rad_s, float request_Nm, float lag_s)
 {
     wc_step_input_t in;
     memset(&in, 0, sizeof in);
@@ -23,7 +24,7 @@ static wc_step_input_t torque_input(float slip_rad_s, float request_Nm, float la
     in.theta_housing_degC = THETA_OIL_degC;
     in.torque_request_Nm = request_Nm;
     in.mode = WC_MODE_TORQUE;
-    in.lag_compensation_time_s = lag_s;
+    in.lag_compensation = wc_lag_compensation(clutch, lag_s);
     in.theta_from_oil = true;  /* the wanted pressure then does not drift with the observer */
     return in;
 }
@@ -36,7 +37,7 @@ static int rise_periods(float request_Nm, float lag_s, float *wanted_Pa, bool *c
     wc_clutch_t clutch;
     assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
     wc_step_output_t out;
-    wc_step_input_t in = torque_input(50.0f, 0.0f, lag_s);
+    wc_step_input_t in = torque_input(&clutch, 50.0f, 0.0f, lag_s);
     for (int k = 0; k < 1000; ++k) { (void)wc_clutch_step(&clutch, &in, &out); }
     const float p0 = out.pressure_model_Pa;
     in.torque_request_Nm = request_Nm;
@@ -100,7 +101,7 @@ static void test_lag_compensation_clamped(void **state)
     wc_clutch_t clutch;
     assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
     wc_step_output_t out;
-    wc_step_input_t in = torque_input(50.0f, 400.0f, 0.015f);
+    wc_step_input_t in = torque_input(&clutch, 50.0f, 400.0f, 0.015f);
     for (int k = 0; k < 500; ++k) { (void)wc_clutch_step(&clutch, &in, &out); }
     in.torque_request_Nm = 0.0f;
     (void)wc_clutch_step(&clutch, &in, &out);
@@ -112,37 +113,89 @@ static void test_lag_compensation_clamped(void **state)
     WC_CHECK((out.status & WC_STATUS_CURRENT_CLAMPED) == 0u, "settled: still CURRENT_CLAMPED");
 }
 
-/* 0, -0, NaN, negative, infinite: exactly the uncompensated step. The
- * same sequence runs on two clutches; outputs and states compared bytewise. */
+/* Off is exactly the uncompensated step: wc_lag_compensation of a time 0,
+ * -0, NaN, negative or infinite, and a hand-filled lag compensation with a
+ * time out of range or a gain that is not finite and positive. The same
+ * sequence runs on two clutches; outputs and states compared bytewise. */
 static void test_lag_compensation_off_is_exact(void **state)
 {
     (void)state;
     const float off[] = { 0.0f, -0.0f, NAN, -NAN, -1e-3f, -1.0f, -INFINITY, INFINITY };
-    for (size_t i = 0u; i < WC_TEST_COUNT(off); ++i) {
+    const wc_lag_compensation_t raw_off[] = {
+        { 0.0f, 1.0f }, { -0.015f, 1.0f }, { NAN, 1.0f }, { 21.0f, 1.0f }, { INFINITY, 1.0f },  /* time */
+        { 0.015f, 0.0f }, { 0.015f, -1.0f }, { 0.015f, NAN }, { 0.015f, INFINITY }, { 0.015f, -INFINITY },  /* gain */
+    };
+    const size_t cases = WC_TEST_COUNT(off) + WC_TEST_COUNT(raw_off);
+    for (size_t i = 0u; i < cases; ++i) {
         wc_clutch_t a;
         wc_clutch_t b;
         memset(&a, 0, sizeof a);
         memset(&b, 0, sizeof b);
         assert_int_equal(wc_clutch_init(&a, &wc_table1_calibration, THETA_OIL_degC), WC_CAL_OK);
         assert_int_equal(wc_clutch_init(&b, &wc_table1_calibration, THETA_OIL_degC), WC_CAL_OK);
+        const wc_lag_compensation_t lag = (i < WC_TEST_COUNT(off)) ? wc_lag_compensation(&b, off[i])
+                                                                   : raw_off[i - WC_TEST_COUNT(off)];
+        if (i < WC_TEST_COUNT(off)) {  /* the constructor says off with zeros */
+            WC_CHECK(wc_test_same_float(lag.time_s, 0.0f) && wc_test_same_float(lag.vfs_gain, 0.0f),
+                     "time %g: wc_lag_compensation not off (%g, %g)", (double)off[i], (double)lag.time_s,
+                     (double)lag.vfs_gain);
+        }
         for (int k = 0; k < 600; ++k) {
             const float request = (k < 100) ? 0.0f : ((k < 300) ? 300.0f : ((k < 450) ? 20.0f : 600.0f));
             const float slip = 80.0f - 0.15f * (float)k;  /* through zero: lock-up too */
-            wc_step_input_t in_a = torque_input(slip, request, 0.0f);
+            wc_step_input_t in_a = torque_input(&a, slip, request, 0.0f);
             in_a.theta_from_oil = false;
             in_a.mode = (k < 550) ? WC_MODE_TORQUE : WC_MODE_OPEN;
             wc_step_input_t in_b = in_a;
-            in_b.lag_compensation_time_s = off[i];
+            in_b.lag_compensation = lag;
             wc_step_output_t out_a;
             wc_step_output_t out_b;
             memset(&out_a, 0, sizeof out_a);
             memset(&out_b, 0, sizeof out_b);
             const wc_status_t sa = wc_clutch_step(&a, &in_a, &out_a);
             const wc_status_t sb = wc_clutch_step(&b, &in_b, &out_b);
-            WC_CHECK(sa == sb, "time %g, step %d: status %x vs %x", (double)off[i], k, (unsigned)sa, (unsigned)sb);
-            WC_CHECK(memcmp(&out_a, &out_b, sizeof out_a) == 0, "time %g, step %d: outputs differ (current %.9g vs %.9g)",
-                     (double)off[i], k, (double)out_a.current_mA, (double)out_b.current_mA);
-            WC_CHECK(memcmp(&a, &b, sizeof a) == 0, "time %g, step %d: states differ", (double)off[i], k);
+            WC_CHECK(sa == sb, "case %zu (time %g, gain %g), step %d: status %x vs %x", i, (double)lag.time_s,
+                     (double)lag.vfs_gain, k, (unsigned)sa, (unsigned)sb);
+            WC_CHECK(memcmp(&out_a, &out_b, sizeof out_a) == 0,
+                     "case %zu (time %g, gain %g), step %d: outputs differ (current %.9g vs %.9g)", i,
+                     (double)lag.time_s, (double)lag.vfs_gain, k, (double)out_a.current_mA, (double)out_b.current_mA);
+            WC_CHECK(memcmp(&a, &b, sizeof a) == 0, "case %zu, step %d: states differ", i, k);
+        }
+    }
+}
+
+/* A lag compensation is made once and used every step: the same as the one
+ * made for the step itself, for any time in range (the gain is the exact
+ * expression of DESIGN 9, computed once). And a hand-filled gain that is
+ * finite and positive, however large or small, keeps every output finite and
+ * the current in the solenoid's range. */
+static void test_lag_compensation_made_once(void **state)
+{
+    (void)state;
+    const wc_calibration_t *cal = &wc_table1_calibration;
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
+    const wc_lag_compensation_t lag = wc_lag_compensation(&clutch, 0.015f);
+    WC_CHECK(wc_test_same_float(lag.time_s, 0.015f), "time %g", (double)lag.time_s);
+    /* (1 - e^(-dt/t)) / (1 - e^(-dt/tau)) in double: 1 ms, 15 ms, tau of table1 */
+    const double expected = (1.0 - exp(-(double)cal->control_period_s / 0.015)) /
+                            (1.0 - exp(-(double)cal->control_period_s / (double)cal->vfs_time_constant_s));
+    WC_CHECK(fabs((double)lag.vfs_gain / expected - 1.0) < 1e-5, "gain %.9g, expected %.9g (float rounding: < 1e-5)",
+             (double)lag.vfs_gain, expected);
+    const float gains[] = { FLT_MIN, 1e-20f, 1e-3f, 1e3f, 1e20f, FLT_MAX };
+    for (size_t i = 0u; i < WC_TEST_COUNT(gains); ++i) {
+        wc_clutch_t c;
+        assert_int_equal(wc_clutch_init(&c, cal, THETA_OIL_degC), WC_CAL_OK);
+        for (int k = 0; k < 400; ++k) {
+            const float request = ((k / 50) % 2 == 0) ? 0.0f : 800.0f;
+            wc_step_input_t in = torque_input(&c, 30.0f, request, 0.0f);
+            in.lag_compensation.time_s = 0.015f;
+            in.lag_compensation.vfs_gain = gains[i];
+            wc_step_output_t out;
+            (void)wc_clutch_step(&c, &in, &out);
+            WC_CHECK(finite_output(&out), "gain %g step %d: non-finite output", (double)gains[i], k);
+            WC_CHECK((out.current_mA >= cal->vfs_current_min_mA) && (out.current_mA <= cal->vfs_current_max_mA),
+                     "gain %g step %d: current %g", (double)gains[i], k, (double)out.current_mA);
         }
     }
 }
@@ -159,7 +212,7 @@ static void test_lag_compensation_any_time_finite(void **state)
         assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
         for (int k = 0; k < 400; ++k) {
             const float request = ((k / 50) % 2 == 0) ? 0.0f : 800.0f;
-            wc_step_input_t in = torque_input(30.0f, request, times[i]);
+            wc_step_input_t in = torque_input(&clutch, 30.0f, request, times[i]);
             wc_step_output_t out;
             (void)wc_clutch_step(&clutch, &in, &out);
             WC_CHECK(finite_output(&out), "time %g step %d: non-finite output", (double)times[i], k);
@@ -221,6 +274,7 @@ int main(void)
         cmocka_unit_test(test_lag_compensation_faster),
         cmocka_unit_test(test_lag_compensation_clamped),
         cmocka_unit_test(test_lag_compensation_off_is_exact),
+        cmocka_unit_test(test_lag_compensation_made_once),
         cmocka_unit_test(test_lag_compensation_any_time_finite),
         cmocka_unit_test(test_theta_from_oil),
     };

@@ -409,7 +409,12 @@ static void op_clutch_step(fz_reader_t *r, unsigned step)
         in.bench.torque_Nm = fz_float(r, -1.2e5f, 1.2e5f);
     }
     /* the shift controller's inputs (DESIGN 9/10): lag compensation, thermal-blind model, carried torque */
-    if ((flags & 0x04u) != 0u) { in.lag_compensation_time_s = fz_float(r, -1.0f, 20.0f); }
+    if ((flags & 0x04u) != 0u) {  /* as wc_lag_compensation makes it, or hand-filled with anything */
+        const float time_s = fz_float(r, -1.0f, 20.0f);
+        in.lag_compensation = wc_lag_compensation(&clutch, time_s);
+        if ((flags & 0x20u) != 0u) { in.lag_compensation.vfs_gain = fz_float(r, -1.0f, 1e30f); }
+        if ((flags & 0x40u) != 0u) { in.lag_compensation.time_s = time_s; }
+    }
     in.theta_from_oil = (flags & 0x08u) != 0u;
     if ((flags & 0x10u) != 0u) { in.carried_torque_Nm = fz_float(r, -10.0f, 6000.0f); }
     const float theta_before = clutch.theta_degC;
@@ -474,8 +479,9 @@ static void op_clutch_step(fz_reader_t *r, unsigned step)
         FZ_CHECK(out.current_mA == cal->vfs_current_max_mA, "locked mode, current %g", (double)out.current_mA);
     }
     /* the wanted pressure: K i, except when the current leads the VFS lag (then within the solenoid's range) */
-    const bool led = mode_known && (in.mode == WC_MODE_TORQUE) && (in.lag_compensation_time_s > 0.0f) &&
-                     (in.lag_compensation_time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s);
+    const bool led = mode_known && (in.mode == WC_MODE_TORQUE) && (in.lag_compensation.time_s > 0.0f) &&
+                     (in.lag_compensation.time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s) &&
+                     (in.lag_compensation.vfs_gain > 0.0f) && (in.lag_compensation.vfs_gain <= FLT_MAX);
     if (led) {
         FZ_CHECK(fz_finite(out.pressure_command_Pa) &&
                      in_range(out.pressure_command_Pa, cal->vfs_gain_Pa_per_mA * cal->vfs_current_min_mA,
