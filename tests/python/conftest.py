@@ -49,8 +49,9 @@ SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faul
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc"}
 VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner"}
 VCAN_TESTS = {"test_vcan_shift_equals_in_process"}
-LONGEST_FIRST = ("test_hil_replay", "test_shift", "test_cli_bad_input", "test_vcan_integration", "test_identify",
-                 "test_vcan_port_faults", "test_replay_inproc", "test_vcan_runner", "test_film_study", "test_lut")
+LONGEST_FIRST = ("test_hil_replay", "test_shift", "test_vcan_integration", "test_identify", "test_cli_output_faults",
+                 "test_vcan_port_faults", "test_replay_inproc", "test_vcan_runner", "test_film_study", "test_lut",
+                 "test_cli_bad_input", "test_bench")
 
 
 def pytest_configure(config):
