@@ -21,7 +21,7 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
     .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
     .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
     .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
-    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (tools/wetclutch/shift.py, tune) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
     .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
     .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
     .lag_compensation_time_s = 0.015f, /* s; modelled pressure led to approach its target with 15 ms instead of tau = 60 ms (DESIGN 9) */
@@ -47,7 +47,7 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
     .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
     .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
-    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (tools/wetclutch/shift.py, tune) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
     .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
     .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
     .lag_compensation_time_s = 0.015f, /* s; modelled pressure led to approach its target with 15 ms instead of tau = 60 ms (DESIGN 9) */
@@ -99,7 +99,7 @@ static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
     .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
     .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
-    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (tools/wetclutch/shift.py, tune) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
     .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
     .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
     .lag_compensation_time_s = 0.0f, /* s; no lag compensation */

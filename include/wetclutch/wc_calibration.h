@@ -103,7 +103,7 @@ typedef enum {
  * Together they prove, from the equations, that every output of every public
  * function is finite and physical on the model's domain: theta in
  * [WC_THETA_MIN_degC, WC_THETA_MAX_degC], |slip| <= WC_SLIP_MAX_rad_s, contact
- * force <= WC_FORCE_MAX_N (wc_config.h). tools/wetclutch/calibration.py applies
+ * force <= WC_FORCE_MAX_N (wc_config.h). tools/wetclutch/calibration/rules.py applies
  * the same rules with the same numbers (LIMITS; tests/python/
  * test_calibration_rules.py compares them with these). Each bound is far
  * outside any real clutch pack; its reason: */

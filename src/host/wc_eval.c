@@ -1,6 +1,6 @@
 /* wc_eval: the firmware's own arithmetic (float, the generated table1
  * calibration and film table) on CSV, for comparison with the double-precision
- * reference `wetclutch reference <mode>` (tools/wetclutch/reference.py), whose
+ * reference `wetclutch reference <mode>` (tools/wetclutch/reference/evaluate.py), whose
  * column names and semantics it follows.
  *
  * A host program: stdio and double are fine here, but every model number

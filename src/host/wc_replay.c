@@ -9,7 +9,7 @@
  * search of `wetclutch shift`), the result checked by
  * wc_shift_calibration_check. --lockstep: after every step's output frames a
  * line "." and a flush, so that a plant simulator can drive the loop in
- * closed loop through a pipe (tools/wetclutch/shift.py).
+ * closed loop through a pipe (tools/wetclutch/shift/tcu.py).
  *
  * Reads a candump -L log (the input frames), feeds each frame the TCU would
  * receive (wc_tcu's kernel filter: ClutchSensors, TorqueRequest, and

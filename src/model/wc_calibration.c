@@ -1,7 +1,7 @@
 /* wc_calibration_check: the rules of DESIGN section 8, "Calibration validity".
  *
  * What each rule proves (the limits and their reasons are in
- * include/wetclutch/wc_calibration.h; tools/wetclutch/calibration.py applies
+ * include/wetclutch/wc_calibration.h; tools/wetclutch/calibration/rules.py applies
  * the same rules). On the model's domain, theta in [WC_THETA_MIN_degC,
  * WC_THETA_MAX_degC], |slip| <= WC_SLIP_MAX_rad_s, 0 <= F_c <= WC_FORCE_MAX_N:
  *  - R_eff = 2/3 (Ro^2 + Ro Ri + Ri^2) / (Ro + Ri) lies in (Ri, Ro) <= 1 m, so

@@ -39,7 +39,7 @@ static void test_matches_eq18_on_a_grid(void **state)
     wc_test_worst_print("mu_f vs eq. 18 (double)", &worst, FRICTION_REL_TOL);
 }
 
-/* mu_f of the golden torque vectors (double reference, tools/wetclutch/model.py).
+/* mu_f of the golden torque vectors (double reference, tools/wetclutch/reference/model).
  * The C gets the sliding speed as the firmware does, R_eff |dw| in float; the
  * reference uses the decimal Table 1 constants where the C has their float
  * roundings (6e-8 each). 2e-6 = the 1e-6 above plus that and the speed's

@@ -14,7 +14,7 @@ static int setup(void **state)
     return (wc_model_init(&model, &wc_table1_calibration) == WC_CAL_OK) ? 0 : -1;
 }
 
-/* Tolerances against the double reference (tools/wetclutch/model.py, exact film):
+/* Tolerances against the double reference (tools/wetclutch/reference/model, exact film):
  *  - h_bar: the LUT's max relative error 3.875e-5 (`wetclutch lut`, grid 100x
  *    denser than the table) + float Hermite evaluation and p_c rounding ~1e-6;
  *  - viscous = c / h_bar: the same 3.9e-5 through 1/h_bar, + mu_v in float

@@ -45,7 +45,7 @@ static void test_paper_value_at_40_degC(void **state)
 }
 
 /* mu_v recovered from the golden viscous torque of the double reference
- * (tools/wetclutch/model.py): T_v = R_eff N_c mu_v A_f v / h_bar (eq. 7), so
+ * (tools/wetclutch/reference/model): T_v = R_eff N_c mu_v A_f v / h_bar (eq. 7), so
  * mu_v = T_v h_bar / (R_eff N_c A_f v). The golden values carry 9 digits
  * (5e-9 relative); the reference's constants are the decimal Table 1 values,
  * the C's their float roundings (6e-8 relative each, 4 of them here). */
