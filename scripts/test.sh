@@ -84,7 +84,7 @@ fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints 
 python_tests() {
   export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
   export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
-  local args=(-n 2 --dist loadgroup -ra --durations=15)   # the 15 slowest tests, to keep an eye on
+  local args=(-n 2 --dist loadscope -ra --durations=15)   # the 15 slowest tests, to keep an eye on
   [ "$quick" = 1 ] && args+=(-m "not slow")
   # pytest's own exit code, its output shown as it comes (and its summary kept for the end)
   .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log"

@@ -42,9 +42,10 @@ def tcu() -> Path:
 # --------------------------------------------------------------------------- how scripts/test.sh runs them
 # slow: left out by `scripts/test.sh --quick` (the edit-compile-test loop); the full command runs all.
 # vcan: boots a QEMU guest (or uses the host's vcan).
-# With pytest-xdist (`-n 2 --dist loadgroup`) each module is one group, run by one worker, so a
-# module's fixtures (a replay, the shift matrix) run once; the longest modules are handed out first
-# (LONGEST_FIRST, measured seconds of each on a 2-core machine), so the two workers end together.
+# With pytest-xdist (`-n 2 --dist loadscope`) each module runs on one worker, so a module's fixtures
+# (a replay, the shift matrix) run once; the longest modules are handed out first (LONGEST_FIRST,
+# longest first as measured on a 2-core machine), so the two workers end together. (Not --dist
+# loadgroup: pytest-xdist 3.8 groups by rewriting item._nodeid, which pytest 9 no longer reads.)
 SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc"}
 VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner"}
@@ -70,6 +71,5 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.slow)
         if module in VCAN_MODULES or (item.originalname or item.name) in VCAN_TESTS:
             item.add_marker(pytest.mark.vcan)
-        item.add_marker(pytest.mark.xdist_group(module))
     rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(_module(item), len(rank)))   # stable: file order otherwise
