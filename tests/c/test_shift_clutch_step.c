@@ -113,6 +113,26 @@ static void test_lag_compensation_clamped(void **state)
     WC_CHECK((out.status & WC_STATUS_CURRENT_CLAMPED) == 0u, "settled: still CURRENT_CLAMPED");
 }
 
+/* 400 steps of a fresh clutch with the request jumping between 0 and 800 Nm
+ * every 50 periods under lag compensation `lag`: every output finite, the
+ * current in the solenoid's range (`what` names the case in a failure). */
+static void hard_requests_stay_finite(const wc_lag_compensation_t *lag, double what)
+{
+    const wc_calibration_t *cal = &wc_table1_calibration;
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
+    for (int k = 0; k < 400; ++k) {
+        const float request = ((k / 50) % 2 == 0) ? 0.0f : 800.0f;
+        wc_step_input_t in = torque_input(&clutch, 30.0f, request, 0.0f);
+        in.lag_compensation = *lag;
+        wc_step_output_t out;
+        (void)wc_clutch_step(&clutch, &in, &out);
+        WC_CHECK(finite_output(&out), "case %g step %d: non-finite output", what, k);
+        WC_CHECK((out.current_mA >= cal->vfs_current_min_mA) && (out.current_mA <= cal->vfs_current_max_mA),
+                 "case %g step %d: current %g", what, k, (double)out.current_mA);
+    }
+}
+
 /* Off is exactly the uncompensated step: wc_lag_compensation of a time 0,
  * -0, NaN, negative or infinite, and a hand-filled lag compensation with a
  * time out of range or a gain that is not finite and positive. The same
@@ -184,19 +204,8 @@ static void test_lag_compensation_made_once(void **state)
              (double)lag.vfs_gain, expected);
     const float gains[] = { FLT_MIN, 1e-20f, 1e-3f, 1e3f, 1e20f, FLT_MAX };
     for (size_t i = 0u; i < WC_TEST_COUNT(gains); ++i) {
-        wc_clutch_t c;
-        assert_int_equal(wc_clutch_init(&c, cal, THETA_OIL_degC), WC_CAL_OK);
-        for (int k = 0; k < 400; ++k) {
-            const float request = ((k / 50) % 2 == 0) ? 0.0f : 800.0f;
-            wc_step_input_t in = torque_input(&c, 30.0f, request, 0.0f);
-            in.lag_compensation.time_s = 0.015f;
-            in.lag_compensation.vfs_gain = gains[i];
-            wc_step_output_t out;
-            (void)wc_clutch_step(&c, &in, &out);
-            WC_CHECK(finite_output(&out), "gain %g step %d: non-finite output", (double)gains[i], k);
-            WC_CHECK((out.current_mA >= cal->vfs_current_min_mA) && (out.current_mA <= cal->vfs_current_max_mA),
-                     "gain %g step %d: current %g", (double)gains[i], k, (double)out.current_mA);
-        }
+        const wc_lag_compensation_t hand_filled = { 0.015f, gains[i] };
+        hard_requests_stay_finite(&hand_filled, (double)gains[i]);
     }
 }
 
@@ -205,20 +214,12 @@ static void test_lag_compensation_made_once(void **state)
 static void test_lag_compensation_any_time_finite(void **state)
 {
     (void)state;
-    const wc_calibration_t *cal = &wc_table1_calibration;
     const float times[] = { FLT_MIN, 1e-20f, 1e-6f, 1e-3f, 0.015f, 0.06f, 0.5f, 10.0f, 20.0f, FLT_MAX };
     for (size_t i = 0u; i < WC_TEST_COUNT(times); ++i) {
         wc_clutch_t clutch;
-        assert_int_equal(wc_clutch_init(&clutch, cal, THETA_OIL_degC), WC_CAL_OK);
-        for (int k = 0; k < 400; ++k) {
-            const float request = ((k / 50) % 2 == 0) ? 0.0f : 800.0f;
-            wc_step_input_t in = torque_input(&clutch, 30.0f, request, times[i]);
-            wc_step_output_t out;
-            (void)wc_clutch_step(&clutch, &in, &out);
-            WC_CHECK(finite_output(&out), "time %g step %d: non-finite output", (double)times[i], k);
-            WC_CHECK((out.current_mA >= cal->vfs_current_min_mA) && (out.current_mA <= cal->vfs_current_max_mA),
-                     "time %g step %d: current %g", (double)times[i], k, (double)out.current_mA);
-        }
+        assert_int_equal(wc_clutch_init(&clutch, &wc_table1_calibration, THETA_OIL_degC), WC_CAL_OK);
+        const wc_lag_compensation_t lag = wc_lag_compensation(&clutch, times[i]);
+        hard_requests_stay_finite(&lag, (double)times[i]);
     }
 }
 
