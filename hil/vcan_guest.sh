@@ -2,15 +2,51 @@
 # Guest side of hil/vcan_run.sh (runs as root in the QEMU guest): bring up the
 # vcan interface, restore the caller's environment and working directory, run
 # the command and leave its exit code in STATE/rc for the host.
-#   bash hil/vcan_guest.sh STATE IFACE    (STATE/env is written by vcan_run.sh)
+#   bash hil/vcan_guest.sh STATE IFACE            (STATE/env is written by vcan_run.sh)
+#   bash hil/vcan_guest.sh --serve DIR IFACE      (one guest for many commands: vcan_run.sh --serve)
+# Serving, it runs the jobs that hosts submit as DIR/jobs/<name>/ (env, then an
+# empty `submitted`), one at a time in name order, each with the interface up
+# again (a job may have set it down), its output in out/err and its exit code
+# in rc; it stops once DIR/stop exists and no job is waiting.
 set -euo pipefail
+up_iface() {
+  modprobe vcan &&
+    { ip link show "$1" >/dev/null 2>&1 || ip link add dev "$1" type vcan; } &&
+    ip link set up "$1"
+}
+fail_iface() {
+  echo "vcan_guest: could not bring up $1 in the guest kernel $(uname -r)" \
+       "(it needs CONFIG_CAN_VCAN: modprobe vcan / ip link failed above)" >&2
+}
+
+if [ "${1:-}" = --serve ]; then
+  dir=$2 VCAN_IFACE=$3
+  if ! up_iface "$VCAN_IFACE"; then fail_iface "$VCAN_IFACE"; echo 125 > "$dir/failed"; exit 125; fi
+  : > "$dir/booted"
+  while :; do
+    job=""
+    for j in "$dir"/jobs/*/; do
+      [ -e "$j/submitted" ] && [ ! -e "$j/taken" ] && { job=${j%/}; break; }
+    done
+    if [ -z "$job" ]; then
+      [ -e "$dir/stop" ] && exit 0
+      sleep 0.1
+      continue
+    fi
+    : > "$job/taken"
+    rc=0
+    if ! up_iface "$VCAN_IFACE" 2>"$job/err"; then fail_iface "$VCAN_IFACE" 2>>"$job/err"; rc=125; else
+      # shellcheck disable=SC1091
+      ( source "$job/env"; cd "$VCAN_CWD"; "${VCAN_CMD[@]}" ) </dev/null >"$job/out" 2>"$job/err" || rc=$?
+    fi
+    echo "$rc" > "$job/rc.tmp" && mv "$job/rc.tmp" "$job/rc"
+  done
+fi
+
 state=$1 VCAN_IFACE=$2
 : > "$state/booted"
-if ! { modprobe vcan &&
-       { ip link show "$VCAN_IFACE" >/dev/null 2>&1 || ip link add dev "$VCAN_IFACE" type vcan; } &&
-       ip link set up "$VCAN_IFACE"; }; then
-  echo "vcan_guest: could not bring up $VCAN_IFACE in the guest kernel $(uname -r)" \
-       "(it needs CONFIG_CAN_VCAN: modprobe vcan / ip link failed above)" >&2
+if ! up_iface "$VCAN_IFACE"; then
+  fail_iface "$VCAN_IFACE"
   echo 125 > "$state/rc"; exit 125
 fi
 # shellcheck disable=SC1091

@@ -38,7 +38,7 @@ report() {  # the time per stage, also after a failure
   if [ -s "${pytest_log:-}" ]; then tail -n 1 "$pytest_log"; fi
 }
 pytest_log=$(mktemp)
-trap 'report; rm -f "$pytest_log"' EXIT
+trap 'report; rm -f "$pytest_log"; vcan_server_stop >/dev/null' EXIT
 stage() {  # stage NAME CMD...: run CMD, record its wall time
   local name=$1 t0=$SECONDS
   shift
@@ -81,14 +81,36 @@ fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints 
   [ "$rc_fuzz" -eq 0 ] || { echo "test: fuzz calibration FAILED (exit $rc_fuzz)" >&2; return "$rc_fuzz"; }
 }
 
+vcan_dir=""
+vcan_server_start() {  # one guest for every vcan test (hil/vcan_run.sh --serve), booting as pytest starts
+  vcan_dir=$(mktemp -d /tmp/vcan_server.XXXXXX)
+  bash hil/vcan_run.sh --serve "$vcan_dir" >"$vcan_dir/log" 2>&1 &
+  vcan_pid=$!
+  export VCAN_SERVER=$vcan_dir
+}
+vcan_server_stop() {
+  [ -n "$vcan_dir" ] || return 0
+  : > "$vcan_dir/stop"
+  for _ in $(seq 600); do kill -0 "$vcan_pid" 2>/dev/null || break; sleep 0.1; done
+  kill "$vcan_pid" 2>/dev/null || true
+  wait "$vcan_pid" 2>/dev/null || true
+  echo "vcan: one guest ran $(find "$vcan_dir/jobs" -name rc 2>/dev/null | wc -l) vcan commands ($(tail -n 1 "$vcan_dir/log"))"
+  rm -rf "$vcan_dir"
+  vcan_dir=""
+}
+
 python_tests() {
   export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
   export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
-  local args=(-n 2 --dist loadscope -ra --durations=15)   # the 15 slowest tests, to keep an eye on
+  # one worker per module, the longest first (tests/python/conftest.py); the 15 slowest tests listed
+  local args=(-n 2 --dist loadscope --no-loadscope-reorder -ra --durations=15)
   [ "$quick" = 1 ] && args+=(-m "not slow")
+  [ "$quick" = 1 ] || vcan_server_start
   # pytest's own exit code, its output shown as it comes (and its summary kept for the end)
-  .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log"
-  return "${PIPESTATUS[0]}"
+  local rc=0
+  .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log" || rc=$?
+  vcan_server_stop
+  return "$rc"
 }
 
 stage "setup (scripts/setup.sh)" bash scripts/setup.sh
