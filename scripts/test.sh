@@ -102,8 +102,9 @@ vcan_server_stop() {
 python_tests() {
   export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
   export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
-  # one worker per module, the longest first (tests/python/conftest.py); the 15 slowest tests listed
-  local args=(-n 2 --dist loadscope --no-loadscope-reorder -ra --durations=15)
+  # the vcan tests on one worker, every other module on one worker, the longest first
+  # (tests/python/conftest.py); the 15 slowest tests listed
+  local args=(-n 2 --dist loadgroup --no-loadscope-reorder -ra --durations=15)
   [ "$quick" = 1 ] && args+=(-m "not slow")
   [ "$quick" = 1 ] || vcan_server_start
   # pytest's own exit code, its output shown as it comes (and its summary kept for the end)

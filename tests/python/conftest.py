@@ -41,35 +41,41 @@ def tcu() -> Path:
 
 # --------------------------------------------------------------------------- how scripts/test.sh runs them
 # slow: left out by `scripts/test.sh --quick` (the edit-compile-test loop); the full command runs all.
-# vcan: boots a QEMU guest (or uses the host's vcan).
-# With pytest-xdist (`-n 2 --dist loadscope`) each module runs on one worker, so a module's fixtures
-# (a replay, the shift matrix) run once; the longest modules are handed out first (LONGEST_FIRST,
-# longest first as measured on a 2-core machine), so the two workers end together. (Not --dist
-# loadgroup: pytest-xdist 3.8 groups by rewriting item._nodeid, which pytest 9 no longer reads.)
+# vcan: runs on a vcan (natively, or in the one QEMU guest that scripts/test.sh boots for them all).
+# With pytest-xdist (`-n 2 --dist loadgroup --no-loadscope-reorder`): the vcan tests are one group, run
+# in turn by one worker (they would only queue for the one guest on two), handed out first; every other
+# module is a group of its own (its fixtures, a replay or the shift matrix, run once), the longest first
+# (LONGEST_FIRST, as measured on a 2-core machine), so the other worker's work ends with the guest's.
 SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc"}
 VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner"}
 VCAN_TESTS = {"test_vcan_shift_equals_in_process"}
-LONGEST_FIRST = ("test_hil_replay", "test_shift", "test_vcan_integration", "test_identify", "test_cli_output_faults",
-                 "test_vcan_port_faults", "test_replay_inproc", "test_vcan_runner", "test_film_study", "test_lut",
-                 "test_cli_bad_input", "test_bench")
+LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_cli_output_faults",
+                 "test_replay_inproc", "test_lut", "test_cli_bad_input", "test_bench")
 
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "slow: left out by scripts/test.sh --quick")
-    config.addinivalue_line("markers", "vcan: needs a vcan (natively or in a QEMU guest)")
+    config.addinivalue_line("markers", "vcan: runs on a vcan (natively or in a QEMU guest)")
 
 
-def _module(item) -> str:
-    return item.module.__name__.rsplit(".", 1)[-1]
+def _group(item) -> str:
+    module = item.module.__name__.rsplit(".", 1)[-1]
+    vcan = module in VCAN_MODULES or (item.originalname or item.name) in VCAN_TESTS
+    return "vcan" if vcan else module
+
+
+def pytest_itemcollected(item):
+    """The marks, as each test is collected (pytest-xdist reads xdist_group in a
+    pytest_collection_modifyitems that runs before this file's)."""
+    if item.module.__name__.rsplit(".", 1)[-1] in SLOW_MODULES:
+        item.add_marker(pytest.mark.slow)
+    group = _group(item)
+    if group == "vcan":
+        item.add_marker(pytest.mark.vcan)
+    item.add_marker(pytest.mark.xdist_group(group))
 
 
 def pytest_collection_modifyitems(config, items):
-    for item in items:
-        module = _module(item)
-        if module in SLOW_MODULES:
-            item.add_marker(pytest.mark.slow)
-        if module in VCAN_MODULES or (item.originalname or item.name) in VCAN_TESTS:
-            item.add_marker(pytest.mark.vcan)
     rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
-    items.sort(key=lambda item: rank.get(_module(item), len(rank)))   # stable: file order otherwise
+    items.sort(key=lambda item: rank.get(_group(item), len(rank)))   # stable: file order otherwise
