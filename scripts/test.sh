@@ -68,21 +68,8 @@ checks() {  # one core's worth, run beside the third fuzzer (called in an || lis
   bash scripts/check_package.sh
 }
 
-fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints whole when done
-  local dir rc_fuzz=0 rc_checks=0
-  dir=$(mktemp -d)
-  FUZZ_BUILD_ONLY=0 bash scripts/fuzz.sh calibration >"$dir/fuzz" 2>&1 & local fuzz_pid=$!
-  checks >"$dir/checks" 2>&1 || rc_checks=$?
-  cat "$dir/checks"
-  wait "$fuzz_pid" || rc_fuzz=$?
-  cat "$dir/fuzz"
-  rm -rf "$dir"
-  [ "$rc_checks" -eq 0 ] || { echo "test: the checks FAILED (exit $rc_checks)" >&2; return "$rc_checks"; }
-  [ "$rc_fuzz" -eq 0 ] || { echo "test: fuzz calibration FAILED (exit $rc_fuzz)" >&2; return "$rc_fuzz"; }
-}
-
 vcan_dir=""
-vcan_server_start() {  # one guest for every vcan test (hil/vcan_run.sh --serve), booting as pytest starts
+vcan_server_start() {  # one guest for every vcan test (hil/vcan_run.sh --serve), booting before pytest
   vcan_dir=$(mktemp -d /tmp/vcan_server.XXXXXX)
   bash hil/vcan_run.sh --serve "$vcan_dir" >"$vcan_dir/log" 2>&1 &
   vcan_pid=$!
@@ -99,6 +86,20 @@ vcan_server_stop() {
   vcan_dir=""
 }
 
+fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints whole when done
+  local dir rc_fuzz=0 rc_checks=0
+  dir=$(mktemp -d)
+  FUZZ_BUILD_ONLY=0 bash scripts/fuzz.sh calibration >"$dir/fuzz" 2>&1 & local fuzz_pid=$!
+  checks >"$dir/checks" 2>&1 || rc_checks=$?
+  cat "$dir/checks"
+  vcan_server_start  # the vcan guest boots on the core the checks leave, while the fuzzer keeps its own
+  wait "$fuzz_pid" || rc_fuzz=$?
+  cat "$dir/fuzz"
+  rm -rf "$dir"
+  [ "$rc_checks" -eq 0 ] || { echo "test: the checks FAILED (exit $rc_checks)" >&2; return "$rc_checks"; }
+  [ "$rc_fuzz" -eq 0 ] || { echo "test: fuzz calibration FAILED (exit $rc_fuzz)" >&2; return "$rc_fuzz"; }
+}
+
 python_tests() {
   export WC_EVAL="$repo/build/host-debug/src/host/wc_eval"
   export WC_IDENTIFY_FULL=1   # the identification targets on the full 184-experiment campaign
@@ -106,7 +107,7 @@ python_tests() {
   # (tests/python/conftest.py); the 15 slowest tests listed
   local args=(-n 2 --dist loadgroup --no-loadscope-reorder -ra --durations=15)
   [ "$quick" = 1 ] && args+=(-m "not slow")
-  [ "$quick" = 1 ] || vcan_server_start
+  [ "$quick" = 1 ] || [ -n "$vcan_dir" ] || vcan_server_start
   # pytest's own exit code, its output shown as it comes (and its summary kept for the end)
   local rc=0
   .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log" || rc=$?

@@ -15,6 +15,7 @@ calibration/ (loading and checking calibration files) and util/ serve them all.
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import os
 import sys
 from pathlib import Path
@@ -94,6 +95,12 @@ def _cmd_vectors(args) -> int:
     return 0
 
 
+def _analyse_replay(calibration_path: str, log: Path, run_dir: Path, reference_check: bool) -> dict:
+    """report.analyse of one log in a worker process (the calibration loaded there)."""
+    from .hil import report
+    return report.analyse(calibration.load(calibration_path), log, run_dir, reference_check=reference_check)
+
+
 def _cmd_replay(args) -> int:
     from .hil import replay, report  # matplotlib and the CAN stack only when needed
     cal = calibration.load(args.calibration)
@@ -111,10 +118,19 @@ def _cmd_replay(args) -> int:
         replay.run_on_vcan(jobs, frame_runs=2, timer_runs=1,
                            calibration=lut.c_identifier(Path(args.calibration).stem))
     missed = []
-    for log, run_dir in jobs:
+    for log, _ in jobs:
         print(f"wetclutch replay: analysing {log.name}"
               + ("" if args.no_reference_check else " (reference check of every step)"), file=sys.stderr, flush=True)
-        m = report.analyse(cal, log, run_dir, reference_check=not args.no_reference_check)
+    check = not args.no_reference_check
+    # the logs' analyses are independent (each its own reference run and plots): on two cores at once
+    workers = min(len(jobs), os.cpu_count() or 1, 2)
+    if workers > 1:
+        with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as pool:
+            results = list(pool.map(_analyse_replay, [args.calibration] * len(jobs), [log for log, _ in jobs],
+                                    [run_dir for _, run_dir in jobs], [check] * len(jobs)))
+    else:
+        results = [report.analyse(cal, log, run_dir, reference_check=check) for log, run_dir in jobs]
+    for (log, run_dir), m in zip(jobs, results):
         print((run_dir / "summary.md").read_text())
         print(f"report: {run_dir}/summary.md, metrics.json, {', '.join(Path(p).name for p in m['plots'])}")
         if not m["all_targets_met"]:
