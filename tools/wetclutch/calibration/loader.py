@@ -2,9 +2,9 @@
 (film_table.py)."""
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
+from ..util.tomlfile import read_toml
 from . import film_table
 from .parameters import PARAMETERS, Calibration, CalibrationError
 from .rules import _check_relations, _check_value
@@ -13,15 +13,7 @@ from .rules import _check_relations, _check_value
 def load(path: str | Path) -> Calibration:
     """Read and validate a calibration file. Raises CalibrationError."""
     path = str(path)
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except OSError as e:
-        raise CalibrationError(f"{path}: cannot read calibration file: {e.strerror}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise CalibrationError(f"{path}: not valid TOML: {e}") from None
-    except UnicodeDecodeError as e:
-        raise CalibrationError(f"{path}: not UTF-8 text (byte {e.start}): not a calibration file") from None
+    doc = read_toml(path, CalibrationError, "calibration file")
 
     known = {(s, n) for s, n, *_ in PARAMETERS}
     for section, table in doc.items():

@@ -18,6 +18,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..util.tomlfile import read_toml
+
 
 class ShiftCalibrationError(Exception):
     """A shift calibration that cannot be used; the message names file, variant and parameter."""
@@ -111,15 +113,7 @@ def _check(path, variant, values):
 
 def load(path: str | Path) -> ShiftCalibrationSet:
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except OSError as e:
-        raise ShiftCalibrationError(f"{path}: cannot read: {e.strerror or e}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ShiftCalibrationError(f"{path}: not valid TOML: {e}") from None
-    except UnicodeDecodeError:
-        raise ShiftCalibrationError(f"{path}: not UTF-8 text: not a TOML file") from None
+    doc = read_toml(path, ShiftCalibrationError, "shift calibration file")
     base = doc.get("shift")
     if not isinstance(base, dict):
         raise ShiftCalibrationError(f"{path}: no [shift] table")

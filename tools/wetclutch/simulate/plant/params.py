@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from ... import calibration
 from ...reference import model
+from ...util.tomlfile import read_toml
 
 
 RPM = model.RAD_S_PER_RPM          # rad/s per rpm
@@ -128,15 +128,7 @@ def load_plant(path) -> PlantParams:
     path relative to the plant file). Raises PlantError naming the file and the parameter."""
     path = Path(path)
     where = str(path)
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except OSError as e:
-        raise PlantError(f"{where}: cannot read plant file: {e.strerror or e}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise PlantError(f"{where}: not valid TOML: {e}") from None
-    except UnicodeDecodeError as e:
-        raise PlantError(f"{where}: not UTF-8 text (byte {e.start}): not a plant file") from None
+    doc = read_toml(path, PlantError, "plant file")
 
     known = {(s, n) for s, n, _, _ in SCHEMA} | {("clutch", "calibration")}
     sections = {s for s, _ in known}
