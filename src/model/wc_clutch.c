@@ -51,6 +51,12 @@ static wc_status_t accept_inputs(wc_held_inputs_t *held, const wc_step_input_t *
     return status;
 }
 
+/* A lag compensation time in (0, WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s]; NaN is not. */
+static bool lag_time_valid(float time_s)
+{
+    return (time_s > 0.0f) && (time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s);
+}
+
 /* DESIGN 9, hydraulic lag: the VFS lag is P' = P + (K i - P)(1 - d), d = e^(-dt/tau)
  * (exact for i held over the period). To move the modelled pressure towards
  * the wanted P* as a lag of time constant t would, P' = P + (P* - P)(1 - e^(-dt/t)),
@@ -81,12 +87,11 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ga
  * D mu_v (-dh_bar/dt) / h_bar^3 with dh_bar/dt = (h_bar* - h_bar) / t; never
  * below the wanted force (the steady command), at most F_max. The piston
  * pressure of that force, as a current, goes to lead_lag. contact_Pa is the
- * asperity pressure p_c(h_bar) of the film state. */
+ * asperity pressure p_c(h_bar) of the film state (film on; t in range: the caller's checks). */
 static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, float viscosity_Pa_s, float time_s,
                       uint32_t film_segment, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
-    if (!(model->film_damping_m4 > 0.0f)) { return; }  /* time_s: in range (the caller's check) */
     const float contact_N = cal->friction_area_m2 * contact_Pa;
     /* the inverse found the force on film_segment: the lookup starts there */
     const float target_hbar_m = wc_film_hbar_near_m(&cal->film, inv->force_N / cal->friction_area_m2, film_segment);
@@ -144,10 +149,9 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
     const wc_lag_compensation_t *lag = &in->lag_compensation;
-    const bool lead = (in->mode == WC_MODE_TORQUE) && (lag->time_s > 0.0f) &&
-                      (lag->time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s) && (lag->vfs_gain > 0.0f) &&
+    const bool lead = (in->mode == WC_MODE_TORQUE) && lag_time_valid(lag->time_s) && (lag->vfs_gain > 0.0f) &&
                       (lag->vfs_gain <= FLT_MAX);  /* also NaN: off */
-    if (lead) { lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, lag->time_s, film_segment, &inv); }
+    if (lead && film) { lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, lag->time_s, film_segment, &inv); }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, lag->vfs_gain, &inv); }
     out->current_mA = inv.current_mA;
@@ -219,8 +223,7 @@ wc_lag_compensation_t wc_lag_compensation(const wc_clutch_t *clutch, float time_
 {
     WC_ASSERT(clutch != NULL);
     wc_lag_compensation_t lag = { 0.0f, 0.0f };  /* off; also for a clutch whose init failed (no calibration) */
-    if ((clutch == NULL) || (clutch->model.cal == NULL) ||
-        !((time_s > 0.0f) && (time_s <= WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s))) {
+    if ((clutch == NULL) || (clutch->model.cal == NULL) || !lag_time_valid(time_s)) {
         return lag;
     }
     /* DESIGN 9, lead_lag: the factor (1 - e^(-dt/t)) / (1 - d), d = e^(-dt/tau); finite and > 0 for
