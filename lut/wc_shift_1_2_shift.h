@@ -29,6 +29,27 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
     .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
     .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
     .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.5f, /* 1; half of the early/late torque ratio's error per shift */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.5f, /* 1; half of a shift's estimated offset */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
 };
 
 /* blind: (b) 2-DOF with a thermal-blind model: clutch temperature = oil temperature */
@@ -55,6 +76,27 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
     .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
     .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.5f, /* 1; half of the early/late torque ratio's error per shift */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.5f, /* 1; half of a shift's estimated offset */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
 };
 
 /* feedback: (a) feedback only: PI on the slip, no feed-forward, no lag compensation */
@@ -81,6 +123,74 @@ static const wc_shift_calibration_t wc_shift_1_2_feedback = {
     .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
     .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
     .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.5f, /* 1; half of the early/late torque ratio's error per shift */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.5f, /* 1; half of a shift's estimated offset */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+};
+
+/* adaptive: (c) with adaptation (DESIGN 12): learns the friction scale per temperature, the film factor and the kiss point */
+static const wc_shift_calibration_t wc_shift_1_2_adaptive = {
+    .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
+    .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
+    .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
+    .prepare_time_s = 0.03f, /* s; fill to the kiss point before the torque phase; 0.05 s flared 109 rpm on the nominal plant (the on-coming torque arrived after the off-going release: VFS and film lag) */
+    .torque_phase_time_s = 0.15f, /* s; torque hand-over, matched to the off-going release schedule (0.10 s + 0.10 s ramp) */
+    .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
+    .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
+    .inertia_timeout_factor = 1.6f, /* 1; abort (release) when the inertia phase lasts 1.6 x its target */
+    .lockup_ramp_time_s = 0.05f, /* s; hand-over from the last request to the holding request */
+    .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
+    .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
+    .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
+    .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
+    .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
+    .lag_compensation_time_s = 0.015f, /* s; modelled pressure led to approach its target with 15 ms instead of tau = 60 ms (DESIGN 9) */
+    .theta_source = 0u, /* 1; 0: the observer's friction-surface temperature */
+    .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
+    .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
+    .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 1u, /* 1; 1: learn from each valid shift and use the learned values */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.5f, /* 1; half of the early/late torque ratio's error per shift */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.5f, /* 1; half of a shift's estimated offset */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
 };
 
 /* nolag: (c) without the lag compensation (pressure-tracking comparison) */
@@ -107,6 +217,27 @@ static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
     .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
     .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.5f, /* 1; half of the early/late torque ratio's error per shift */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.5f, /* 1; half of a shift's estimated offset */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
 };
 
 #endif /* WC_LUT_SHIFT_1_2_SHIFT_H */

@@ -41,6 +41,21 @@ typedef struct {
     float vfs_gain;  /* (1 - e^(-dt/t)) / (1 - e^(-dt/tau)): the VFS lag's inverse for t, > 0 when on */
 } wc_lag_compensation_t;
 
+/* The adaptation's correction of the model (DESIGN 12, wc_adapt.h), made by
+ * wc_adapt_correction. Zero (zero-initialized): none, bit for bit the
+ * calibration's model. A field outside its range (NaN included) voids the
+ * whole correction (none; no status bit): the ranges are the widest bands a
+ * shift calibration accepts. */
+typedef struct {
+    float friction_scale_delta;  /* mu_f (eq. 18) x (1 + this), within [-WC_CORRECTION_SCALE_MAX, WC_CORRECTION_SCALE_MAX] */
+    float film_factor_delta;     /* the squeeze film's damping (DESIGN 9) x (1 + this), within [WC_CORRECTION_FILM_DELTA_MIN, WC_CORRECTION_FILM_DELTA_MAX] */
+    float kiss_offset_N;         /* contact force = apply force - this (a later kiss point: > 0), |.| <= WC_CORRECTION_KISS_MAX_N */
+} wc_model_correction_t;
+#define WC_CORRECTION_SCALE_MAX 0.5f
+#define WC_CORRECTION_FILM_DELTA_MIN (-0.995f)
+#define WC_CORRECTION_FILM_DELTA_MAX 19.0f
+#define WC_CORRECTION_KISS_MAX_N 5000.0f
+
 typedef struct {
     float slip_rad_s;          /* clutch slip speed dw, signed */
     float theta_oil_degC;      /* oil (sump) temperature */
@@ -69,6 +84,8 @@ typedef struct {
      * commands more to lock). 0 (zero-initialized), not finite or out of
      * range: the request. A bench's torque sensor takes precedence. */
     float carried_torque_Nm;
+    /* The adaptation's correction (wc_adapt_correction); zero: none. */
+    wc_model_correction_t correction;
 } wc_step_input_t;
 
 typedef struct {

@@ -38,6 +38,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "wc_adapt.h"
 #include "wc_clutch.h"
 
 typedef enum {
@@ -68,7 +69,7 @@ typedef enum {
     WC_SHIFT_THETA_OIL = 1        /* the oil temperature: a thermal-blind model (comparison only) */
 } wc_shift_theta_source_t;
 
-typedef struct {
+typedef struct wc_shift_calibration {
     /* The TCU's driveline model (DESIGN 10): the turbine side and the clutch's kinematics. */
     float turbine_inertia_kg_m2;       /* I_t: turbine + engine (converter locked) */
     float turbine_ratio;               /* a in slip = a w_t - b w_o: clutch slip per turbine speed */
@@ -96,6 +97,25 @@ typedef struct {
     float flare_slip_rad_s;            /* slip above the slip at inertia start + this: flare */
     float tie_up_factor;               /* torque-phase request estimate above factor * T_t / a while the slip holds: tie-up */
     float jerk_filter_time_s;          /* first-order filter on the torque before its rate is taken */
+    /* Adaptation (DESIGN 12, wc_adapt.h): the learning rules; 0 = off, the
+     * controller bit for bit the unadapted one. */
+    uint32_t adaptation;               /* 1: learn (wc_adapt_t of wc_shift_step) and use the learned values */
+    float adapt_theta_node_degC[WC_ADAPT_NODES];  /* the friction scale's temperatures, strictly increasing */
+    float adapt_scale_band;            /* |friction scale - 1| <= band */
+    float adapt_scale_step;            /* |change of a node's scale| per shift <= step */
+    float adapt_scale_gain;            /* fraction of the measured error taken per shift */
+    float adapt_confidence_gain;       /* confidence += gain * share * (1 - confidence) per update */
+    float adapt_film_factor_min;       /* the film factor's band (a multiplier, 1 = the calibration's) */
+    float adapt_film_factor_max;
+    float adapt_film_step;             /* |relative change of the film factor| per shift <= step */
+    float adapt_film_gain;
+    float adapt_kiss_band_Pa;          /* |kiss offset| <= band */
+    float adapt_kiss_step_Pa;          /* |change of the kiss offset| per shift <= step */
+    float adapt_kiss_gain;
+    float adapt_window_skip_s;         /* the window starts this long after the inertia phase's start */
+    float adapt_film_window_s;         /* the film factor's early part of the window */
+    float adapt_min_slip_drop;         /* excitation: the slip falls by this fraction of its window start */
+    float adapt_min_conditioning;      /* the kiss point's least squares: D / (S11 S22) at least this */
 } wc_shift_calibration_t;
 
 /* Which field an invalid shift calibration fails on (0 = valid): the fields
@@ -125,6 +145,27 @@ typedef enum {
     WC_SHIFT_CAL_FLARE_SLIP,
     WC_SHIFT_CAL_TIE_UP_FACTOR,
     WC_SHIFT_CAL_JERK_FILTER_TIME,
+    WC_SHIFT_CAL_ADAPTATION,
+    WC_SHIFT_CAL_ADAPT_THETA_NODE0,    /* one code per node (WC_ADAPT_NODES): strictly increasing */
+    WC_SHIFT_CAL_ADAPT_THETA_NODE1,
+    WC_SHIFT_CAL_ADAPT_THETA_NODE2,
+    WC_SHIFT_CAL_ADAPT_THETA_NODE3,
+    WC_SHIFT_CAL_ADAPT_THETA_NODE4,
+    WC_SHIFT_CAL_ADAPT_SCALE_BAND,
+    WC_SHIFT_CAL_ADAPT_SCALE_STEP,
+    WC_SHIFT_CAL_ADAPT_SCALE_GAIN,
+    WC_SHIFT_CAL_ADAPT_CONFIDENCE_GAIN,
+    WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MIN,
+    WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MAX,
+    WC_SHIFT_CAL_ADAPT_FILM_STEP,
+    WC_SHIFT_CAL_ADAPT_FILM_GAIN,
+    WC_SHIFT_CAL_ADAPT_KISS_BAND,
+    WC_SHIFT_CAL_ADAPT_KISS_STEP,
+    WC_SHIFT_CAL_ADAPT_KISS_GAIN,
+    WC_SHIFT_CAL_ADAPT_WINDOW_SKIP,
+    WC_SHIFT_CAL_ADAPT_FILM_WINDOW,
+    WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP,
+    WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING,
     WC_SHIFT_CAL_ERRORS
 } wc_shift_cal_error_t;
 
@@ -137,6 +178,8 @@ typedef enum {
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s 0.05f
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s 5.0f
 #define WC_SHIFT_LIMIT_GAIN_MAX 1e5f
+/* The kiss offset's band: at most 1 MPa (a kiss pressure is about 0.1 MPa). */
+#define WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa 1e6f
 /* The hand-over waits this many lockup_ramp_time_s for the lock-up (its dwell, a slow cold film). */
 #define WC_SHIFT_LOCKUP_WAIT 4u
 
@@ -160,6 +203,7 @@ typedef struct {
     bool flare;
     bool tie_up;
     uint32_t abort_reason;         /* wc_shift_abort_t */
+    wc_adapt_change_t adaptation;  /* what the shift changed of the learned values (DESIGN 12) */
 } wc_shift_report_t;
 
 typedef struct {
@@ -211,9 +255,11 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
  * out must hold the previous step's output (zero-initialised before the
  * first): its WC_STATUS_SATURATED stops the integral (anti-windup). A request
  * bit already 1 when the safe state ends starts no shift: a new 0 -> 1 edge
- * is needed (no restart without the VCU's consent). */
+ * is needed (no restart without the VCU's consent). adapt: the clutch's
+ * learned values (DESIGN 12), used and updated when cal->adaptation is 1;
+ * NULL (or adaptation 0): none, and the report's adaptation part says OFF. */
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                   bool safe, wc_clutch_t *clutch, wc_step_input_t *in, wc_step_output_t *out,
+                   bool safe, wc_clutch_t *clutch, wc_adapt_t *adapt, wc_step_input_t *in, wc_step_output_t *out,
                    wc_shift_report_t *report);
 
 #endif /* WC_SHIFT_H */

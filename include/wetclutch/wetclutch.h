@@ -16,6 +16,9 @@
 #include "wc_lockup.h"
 #include "wc_clutch.h"
 #include "wc_shift.h"
+#include "wc_adapt.h"
+#include "wc_image.h"
+#include "wc_adapt_image.h"
 
 /* rpm <-> rad/s, for callers whose sensors speak rpm. */
 #define WC_RAD_S_PER_RPM 0.10471975511965977f

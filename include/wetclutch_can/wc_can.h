@@ -52,6 +52,7 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_FRAME_ID (0x120u)
 #define WC_CAN_CLUTCH_ESTIMATE_FRAME_ID (0x121u)
 #define WC_CAN_SHIFT_REPORT_FRAME_ID (0x122u)
+#define WC_CAN_ADAPTATION_REPORT_FRAME_ID (0x123u)
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
 
 /* Frame lengths in bytes. */
@@ -61,6 +62,7 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_CLUTCH_ESTIMATE_LENGTH (8u)
 #define WC_CAN_SHIFT_REPORT_LENGTH (8u)
+#define WC_CAN_ADAPTATION_REPORT_LENGTH (8u)
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
 
 /* Extended or standard frame types. */
@@ -70,6 +72,7 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_CLUTCH_ESTIMATE_IS_EXTENDED (0)
 #define WC_CAN_SHIFT_REPORT_IS_EXTENDED (0)
+#define WC_CAN_ADAPTATION_REPORT_IS_EXTENDED (0)
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
 
 /* Frame cycle times in milliseconds. */
@@ -134,6 +137,7 @@ extern "C" {
 #define WC_CAN_VFS_COMMAND_NAME "VfsCommand"
 #define WC_CAN_CLUTCH_ESTIMATE_NAME "ClutchEstimate"
 #define WC_CAN_SHIFT_REPORT_NAME "ShiftReport"
+#define WC_CAN_ADAPTATION_REPORT_NAME "AdaptationReport"
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
 
 /* Signal Names. */
@@ -149,6 +153,7 @@ extern "C" {
 #define WC_CAN_SHIFT_COMMAND_CRC_NAME "Crc"
 #define WC_CAN_SHIFT_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_SHIFT_COMMAND_SHIFT_REQUEST_NAME "ShiftRequest"
+#define WC_CAN_SHIFT_COMMAND_ADAPTATION_RESET_NAME "AdaptationReset"
 #define WC_CAN_SHIFT_COMMAND_TARGET_GEAR_NAME "TargetGear"
 #define WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_NAME "TurbineTorque"
 #define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_NAME "TargetInertiaTime"
@@ -184,6 +189,15 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_FLARE_NAME "Flare"
 #define WC_CAN_SHIFT_REPORT_TIE_UP_NAME "TieUp"
 #define WC_CAN_SHIFT_REPORT_ABORT_REASON_NAME "AbortReason"
+#define WC_CAN_ADAPTATION_REPORT_RESULT_NAME "Result"
+#define WC_CAN_ADAPTATION_REPORT_NODE_NAME "Node"
+#define WC_CAN_ADAPTATION_REPORT_IMAGE_MISSING_NAME "ImageMissing"
+#define WC_CAN_ADAPTATION_REPORT_IMAGE_INVALID_NAME "ImageInvalid"
+#define WC_CAN_ADAPTATION_REPORT_FRICTION_SCALE_NAME "FrictionScale"
+#define WC_CAN_ADAPTATION_REPORT_FRICTION_SCALE_CHANGE_NAME "FrictionScaleChange"
+#define WC_CAN_ADAPTATION_REPORT_CONFIDENCE_NAME "Confidence"
+#define WC_CAN_ADAPTATION_REPORT_FILM_FACTOR_NAME "FilmFactor"
+#define WC_CAN_ADAPTATION_REPORT_KISS_OFFSET_NAME "KissOffset"
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_NAME "LoadCellForce"
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_NAME "MeasuredTorque"
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
@@ -321,6 +335,15 @@ struct wc_can_shift_command_t {
      * Offset: 0
      */
     uint8_t shift_request;
+
+    /**
+     * 1: reset the clutch's learned values (DESIGN 12) to the calibration's on a 0->1 edge while no shift runs; acknowledged by an AdaptationReport with Result 0 and written to the adaptation image. Ignored during a shift (the edge must come after it).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t adaptation_reset;
 
     /**
      * Target gear of the shift. Only 2 (the 1->2 upshift) is supported; another value aborts the shift (AbortReason 5).
@@ -663,6 +686,96 @@ struct wc_can_shift_report_t {
      * Offset: 0
      */
     uint8_t abort_reason;
+};
+
+/**
+ * Signals in message AdaptationReport.
+ *
+ * Adaptation report (DESIGN 12), sent with ShiftReport when adaptation is on (shift calibration adaptation = 1), and after a reset by ShiftCommand.AdaptationReset: what the shift changed of the learned values. Not used for control, not E2E protected.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_adaptation_report_t {
+    /**
+     * 0 adaptation off or values reset; 1 updated; 2 shift aborted (nothing learned); 3 an input was invalid during the window; 4 too little excitation; 5 implausible torque ratio.
+     *
+     * Range: 0..5 (0..5 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t result;
+
+    /**
+     * The friction-scale node (temperature cell) with the largest share of the shift's window; the scale and confidence below are that node's.
+     *
+     * Range: 0..4 (0..4 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t node;
+
+    /**
+     * 1: no adaptation image at init: the calibration's values were used.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t image_missing;
+
+    /**
+     * 1: the adaptation image at init was invalid (magic, version, length, CRC-32 or a value outside its band): the calibration's values were used.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t image_invalid;
+
+    /**
+     * Learned friction scale (multiplies mu_f) of Node after the shift.
+     *
+     * Range: 0..4000 (0.5..1.5 -)
+     * Scale: 0.00025
+     * Offset: 0.5
+     */
+    uint16_t friction_scale;
+
+    /**
+     * Change of that scale by this shift.
+     *
+     * Range: -2000..2000 (-0.5..0.5 -)
+     * Scale: 0.00025
+     * Offset: 0
+     */
+    int16_t friction_scale_change;
+
+    /**
+     * Confidence of Node after the shift, 0..1.
+     *
+     * Range: 0..100 (0..1 -)
+     * Scale: 0.01
+     * Offset: 0
+     */
+    uint8_t confidence;
+
+    /**
+     * Learned squeeze-film factor (multiplies the calibration's) after the shift.
+     *
+     * Range: 0..4000 (0..20 -)
+     * Scale: 0.005
+     * Offset: 0
+     */
+    uint16_t film_factor;
+
+    /**
+     * Learned kiss point minus the calibration's (return_spring_force / piston_area), kPa.
+     *
+     * Range: -4000..4000 (-1000..1000 kPa)
+     * Scale: 0.25
+     * Offset: 0
+     */
+    int16_t kiss_offset;
 };
 
 /**
@@ -1075,6 +1188,28 @@ bool wc_can_shift_command_shift_request_is_in_range(uint8_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_shift_command_shift_request_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_adaptation_reset_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_adaptation_reset_is_in_phys_range(float value);
 
 /**
  * Check that given signal is in allowed range.
@@ -1956,6 +2091,241 @@ bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_shift_report_abort_reason_is_in_phys_range(float value);
+
+/**
+ * Pack message AdaptationReport.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_adaptation_report_pack(
+    uint8_t *dst_p,
+    const struct wc_can_adaptation_report_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message AdaptationReport.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_adaptation_report_unpack(
+    struct wc_can_adaptation_report_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from AdaptationReport.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_adaptation_report_init(struct wc_can_adaptation_report_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_result_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_result_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_node_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_node_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_image_missing_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_image_missing_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_image_invalid_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_image_invalid_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_friction_scale_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_friction_scale_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_friction_scale_change_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_friction_scale_change_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_confidence_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_confidence_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_film_factor_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_film_factor_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_kiss_offset_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_adaptation_report_kiss_offset_is_in_phys_range(float value);
 
 /**
  * Pack message BenchMeasurement.

@@ -40,6 +40,7 @@ extern const wc_can_signal_t wc_can_sig_clutch_sensors_oil_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_clutch_sensors_housing_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_torque_request_torque_request; /* Nm */
 extern const wc_can_signal_t wc_can_sig_shift_command_shift_request; /* 1 */
+extern const wc_can_signal_t wc_can_sig_shift_command_adaptation_reset; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_gear; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_turbine_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time; /* ms */
@@ -56,6 +57,15 @@ extern const wc_can_signal_t wc_can_sig_shift_report_friction_energy; /* kJ */
 extern const wc_can_signal_t wc_can_sig_shift_report_peak_clutch_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_shift_report_flare; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_report_tie_up; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_result; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_node; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_image_missing; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_image_invalid; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale_change; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_confidence; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_film_factor; /* 1 */
+extern const wc_can_signal_t wc_can_sig_adaptation_report_kiss_offset; /* kPa */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force; /* N */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
@@ -78,6 +88,7 @@ typedef struct {
 /** ShiftCommand (0x112) in physical units. */
 typedef struct {
     float shift_request;
+    float adaptation_reset;
     float target_gear;
     float turbine_torque_Nm;
     float target_inertia_time_ms;
@@ -113,6 +124,19 @@ typedef struct {
     uint8_t abort_reason; /**< WC_CAN_SHIFT_REPORT_ABORT_REASON_*_CHOICE */
 } wc_can_shift_report_phys_t;
 
+/** AdaptationReport (0x123) in physical units. */
+typedef struct {
+    float result;
+    float node;
+    float image_missing;
+    float image_invalid;
+    float friction_scale;
+    float friction_scale_change;
+    float confidence;
+    float film_factor;
+    float kiss_offset_kPa;
+} wc_can_adaptation_report_phys_t;
+
 /** BenchMeasurement (0x130) in physical units. */
 typedef struct {
     float load_cell_force_N;
@@ -136,6 +160,8 @@ wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_
 wc_can_result_t wc_can_decode_clutch_estimate(wc_can_clutch_estimate_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_shift_report(uint8_t *dst, const wc_can_shift_report_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_adaptation_report(uint8_t *dst, const wc_can_adaptation_report_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_adaptation_report(wc_can_adaptation_report_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t *dst, const uint8_t *src, size_t size);
 

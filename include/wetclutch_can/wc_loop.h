@@ -58,6 +58,7 @@
 #define WC_LOOP_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "wc_can_frame.h"
@@ -68,7 +69,7 @@
 
 #define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */
 #define WC_LOOP_TX_CYCLIC 2u      /* every step: VfsCommand, ClutchEstimate */
-#define WC_LOOP_TX_FRAMES 3u      /* at most: ... then ShiftReport in the step a shift ends */
+#define WC_LOOP_TX_FRAMES 4u      /* at most: ... then ShiftReport and AdaptationReport in the step a shift ends */
 
 typedef struct {
     uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit (default 10) */
@@ -77,9 +78,17 @@ typedef struct {
     uint32_t recovery_periods;         /* both inputs fresh this long before the safe state ends (20) */
     bool bench_input_enabled;          /* use BenchMeasurement (bench only; default off) */
     const wc_shift_calibration_t *shift;  /* shift control (DESIGN 10; checked at init); NULL: off */
+    /* Adaptation (DESIGN 12, shift calibration adaptation = 1): called from
+     * wc_loop_step after the output frames of a step in which the learned
+     * values changed (a shift updated them, or a reset by
+     * ShiftCommand.AdaptationReset), with the clutch's adaptation state, for
+     * the integrator to persist (wc_adapt_image_write). It runs in the control
+     * task: it must only copy or schedule (an NVM job), not block. NULL: none. */
+    void (*adaptation_changed)(const wc_adapt_t *adapt, void *context);
+    void *adaptation_context;
 } wc_loop_config_t;
 
-#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL }
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL, NULL, NULL }
 
 typedef enum {
     WC_REJECT_CRC = 0,      /* E2E CRC mismatch */
@@ -128,6 +137,8 @@ typedef struct {
     wc_can_shift_command_phys_t shift_command;  /* last valid */
     wc_shift_t shift;                       /* the shift controller (config.shift) */
     wc_shift_report_t report;               /* the last shift's quality vector */
+    wc_adapt_t adapt;                       /* the clutch's learned values (DESIGN 12) */
+    bool last_adaptation_reset;             /* ShiftCommand.AdaptationReset at the last step (edge) */
     wc_can_torque_request_phys_t request;   /* last valid */
     wc_can_bench_measurement_phys_t bench;  /* last valid */
     uint32_t fresh_periods;                 /* consecutive periods with both control inputs fresh */
@@ -144,6 +155,15 @@ typedef struct {
  * WC_CAL_NULL) and start in the safe state (no input seen). */
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC);
+
+/* Load the clutch's learned values from an adaptation image (wc_adapt_image.h)
+ * after wc_loop_init, before the first step: an image that is NULL, empty,
+ * truncated, of another version or clutch, with a bad CRC-32 or a value
+ * outside its band gives the calibration's values and sets
+ * WC_ADAPT_STATUS_IMAGE_MISSING / _INVALID (sent in AdaptationReport). Without
+ * a call the loop starts from the calibration's values with IMAGE_MISSING.
+ * Returns the image load's code (wc_adapt_image.h). */
+uint32_t wc_loop_load_adaptation(wc_loop_t *loop, const uint8_t *image, size_t length);
 
 /* Queue one received frame for the next step. Returns false (and counts
  * WC_REJECT_OVERFLOW) when the ring is full. */

@@ -9,7 +9,8 @@
 /* Sizes the loop relies on. */
 WC_STATIC_ASSERT((WC_LOOP_RX_CAPACITY & (WC_LOOP_RX_CAPACITY - 1u)) == 0u, rx_ring_is_a_power_of_two);
 WC_STATIC_ASSERT(WC_LOOP_RX_CAPACITY >= 2u * WC_LOOP_RX_ID_COUNT, rx_ring_holds_two_periods_of_input);
-WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == 3u), tx_is_command_estimate_and_report);
+WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == 4u), tx_is_command_estimate_and_reports);
+WC_STATIC_ASSERT(WC_CAN_ADAPTATION_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), adaptation_report_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, shift_command_is_an_e2e_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), shift_report_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_CLUTCH_SENSORS_LENGTH == WC_E2E_FRAME_BYTES, clutch_sensors_is_an_e2e_frame);
@@ -39,6 +40,8 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
     if (error != WC_CAL_OK) { return error; }
     wc_shift_init(&loop->shift);
+    wc_adapt_reset(&loop->adapt);
+    loop->adapt.status = WC_ADAPT_STATUS_IMAGE_MISSING;  /* until wc_loop_load_adaptation */
     loop->config = *config;
     input_reset(&loop->sensors_in);
     input_reset(&loop->request_in);
@@ -48,6 +51,13 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     loop->sensors.housing_temp_degC = theta_start_degC;
     loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
     return WC_CAL_OK;
+}
+
+uint32_t wc_loop_load_adaptation(wc_loop_t *loop, const uint8_t *image, size_t length)
+{
+    WC_ASSERT(loop != NULL);
+    if (loop == NULL) { return (uint32_t)WC_IMAGE_MISSING; }
+    return wc_adapt_image_load(&loop->adapt, loop->config.shift, 0u, image, length);
 }
 
 /* Status bit of each reject reason, indexed by wc_loop_reject_t in its
@@ -156,7 +166,7 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
         }
         if (accept(loop, &loop->request_in, r, true, q.alive_counter)) { loop->request = q; }
     } else if ((f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID) && (loop->config.shift != NULL)) {
-        wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0u};
+        wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_shift_command(&c, f->data, f->dlc);
         if (accept(loop, &loop->shift_in, r, true, c.alive_counter)) { loop->shift_command = c; }
     } else if ((f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) && loop->config.bench_input_enabled) {
@@ -240,6 +250,27 @@ static WC_NOINLINE void encode_report(const wc_shift_report_t *q, wc_can_frame_t
     (void)wc_can_encode_shift_report(out->data, &report, sizeof out->data);  /* saturates to the DBC ranges */
 }
 
+/* The adaptation report frame (DBC AdaptationReport): what the last shift
+ * changed, or a reset (result OFF), with the image's status. */
+static WC_NOINLINE void encode_adaptation(const wc_adapt_change_t *a, uint32_t adapt_status, wc_can_frame_t *out)
+{
+    const wc_can_adaptation_report_phys_t report = {
+        .result = (float)a->result,
+        .node = (float)a->node,
+        .image_missing = ((adapt_status & WC_ADAPT_STATUS_IMAGE_MISSING) != 0u) ? 1.0f : 0.0f,
+        .image_invalid = ((adapt_status & WC_ADAPT_STATUS_IMAGE_INVALID) != 0u) ? 1.0f : 0.0f,
+        .friction_scale = a->friction_scale,
+        .friction_scale_change = a->friction_scale_change,
+        .confidence = a->confidence,
+        .film_factor = a->film_factor,
+        .kiss_offset_kPa = a->kiss_offset_Pa * 1.0e-3f,
+    };
+    out->id = WC_CAN_ADAPTATION_REPORT_FRAME_ID;
+    out->dlc = WC_CAN_ADAPTATION_REPORT_LENGTH;
+    out->flags = 0u;
+    (void)wc_can_encode_adaptation_report(out->data, &report, sizeof out->data);  /* saturates to the DBC ranges */
+}
+
 /* The two cyclic output frames of a step. Apart from wc_loop_step so that its
  * locals are not on the stack while the model runs. */
 static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
@@ -278,8 +309,9 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 #define STEP_SHIFT (1uL << 16)   /* the shift controller steps the clutch */
 #define STEP_SAFE (1uL << 17)    /* the safe state is active */
 #define STEP_REPORT (1uL << 18)  /* a shift ended: ShiftReport */
-/* prepare() sets the clutch input field by field: all eleven of them (a new field fails here). */
-WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 12u * 4u, the_loop_sets_every_field_of_the_clutch_input);
+#define STEP_ADAPT (1uL << 19)   /* the learned values changed or were reset: AdaptationReport, the hook */
+/* prepare() sets the clutch input field by field: all of them (a new field fails here). */
+WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 15u * 4u, the_loop_sets_every_field_of_the_clutch_input);
 WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_bits_below_the_step_flags);
 
 /* The frames of this period, the inputs' freshness and the safe state, then
@@ -344,6 +376,9 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     in->lag_compensation.vfs_gain = 0.0f;
     in->theta_from_oil = false;
     in->carried_torque_Nm = 0.0f;
+    in->correction.friction_scale_delta = 0.0f;  /* the shift controller sets it (DESIGN 12) */
+    in->correction.film_factor_delta = 0.0f;
+    in->correction.kiss_offset_N = 0.0f;
     if (bench_fresh) { step |= WC_CAN_STATUS_BENCH_INPUT; }
     if (safe) {
         step |= WC_CAN_STATUS_SAFE_STATE_ACTIVE | STEP_SAFE;
@@ -353,6 +388,16 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     if (!shift_mode && !shift_running && (loop->shift.phase != (uint32_t)WC_SHIFT_IDLE)) {
         wc_shift_init(&loop->shift);  /* a finished shift ends with its mode: the new mode acts now */
     }
+    /* DESIGN 12: a reset of the learned values on a 0 -> 1 edge of the (valid) AdaptationReset, not during a shift */
+    const bool reset = (loop->config.shift != NULL) && shift_mode && (loop->shift_command.adaptation_reset > 0.5f);
+    if (reset && !loop->last_adaptation_reset && !shift_running && !safe) {
+        wc_adapt_reset(&loop->adapt);
+        loop->adapt.status |= WC_ADAPT_STATUS_RESET;
+        const wc_adapt_change_t none = { (uint32_t)WC_ADAPT_RESULT_OFF, 0u, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f };
+        loop->report.adaptation = none;
+        step |= STEP_ADAPT;
+    }
+    loop->last_adaptation_reset = reset;
     if ((loop->config.shift != NULL) && (shift_mode || shift_running)) {
         /* the shift controller owns the clutch; leaving Shift mode mid-shift withdraws the command (abort) */
         const wc_can_shift_command_phys_t *c = &loop->shift_command;
@@ -374,6 +419,12 @@ static uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOO
     encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
     if ((step & STEP_REPORT) != 0u) { encode_report(&loop->report, &out[n++]); }
+    if ((step & STEP_ADAPT) != 0u) {
+        encode_adaptation(&loop->report.adaptation, loop->adapt.status, &out[n++]);
+        if (loop->config.adaptation_changed != NULL) {
+            loop->config.adaptation_changed(&loop->adapt, loop->config.adaptation_context);
+        }
+    }
     loop->counters.steps++;
     loop->counters.frames_out += n;
     return n;
@@ -391,8 +442,10 @@ static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bo
     uint32_t step = prepare(loop);
     if ((step & STEP_SHIFT) != 0u) {
         if (wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u, &loop->clutch,
-                          &loop->input, &loop->last, &loop->report)) {
+                          &loop->adapt, &loop->input, &loop->last, &loop->report)) {
             step |= STEP_REPORT;
+            /* adaptation on: what the shift changed goes out with the report (the hook persists it) */
+            if (loop->config.shift->adaptation == 1u) { step |= STEP_ADAPT; }
         }
     } else {
         (void)wc_clutch_step(&loop->clutch, &loop->input, &loop->last);  /* its status is loop->last.status */

@@ -104,7 +104,7 @@ uint32_t wc_field_first_invalid(const void *fields, const wc_field_rules_t *rule
 {
     const unsigned char *base = (const unsigned char *)fields;
     float previous = 0.0f;
-    for (uint32_t i = 0u; (i < 32u) && (i < rules->count); ++i) {
+    for (uint32_t i = 0u; (i < WC_FIELD_MAX_COUNT) && (i < rules->count); ++i) {
         const uint32_t flags = rules->flags[i];
         float x;
         if ((flags & WC_FIELD_INTEGER) != 0u) {

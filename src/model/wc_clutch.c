@@ -88,20 +88,44 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ga
  * below the wanted force (the steady command), at most F_max. The piston
  * pressure of that force, as a current, goes to lead_lag. contact_Pa is the
  * asperity pressure p_c(h_bar) of the film state (film on; t in range: the caller's checks). */
-static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, float viscosity_Pa_s, float time_s,
-                      uint32_t film_segment, wc_inverse_t *inv)
+static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, float damping_N_s_m2, float time_s,
+                      uint32_t film_segment, float kiss_offset_N, wc_inverse_t *inv)
 {
     const wc_calibration_t *cal = model->cal;
     const float contact_N = cal->friction_area_m2 * contact_Pa;
     /* the inverse found the force on film_segment: the lookup starts there */
     const float target_hbar_m = wc_film_hbar_near_m(&cal->film, inv->force_N / cal->friction_area_m2, film_segment);
     if (!(hbar_m > target_hbar_m)) { return; }  /* at or past the wanted film: the steady force */
-    const float squeeze_N = model->film_damping_m4 * viscosity_Pa_s * (hbar_m - target_hbar_m) /
+    const float squeeze_N = damping_N_s_m2 * (hbar_m - target_hbar_m) /
                             (time_s * hbar_m * hbar_m * hbar_m);  /* h_bar >= the table's minimum: finite */
     float force_N = contact_N + squeeze_N;
     if (!(force_N > inv->force_N)) { return; }
     force_N = (force_N < model->force_max_N) ? force_N : model->force_max_N;
-    (void)wc_vfs_current_mA(cal, wc_piston_pressure_Pa(cal, force_N), &inv->current_mA);  /* within range: F <= F_max */
+    /* the pressure of F plus the learned kiss offset (DESIGN 12); the current clamped to the solenoid's range */
+    (void)wc_vfs_current_mA(cal, wc_piston_pressure_Pa(cal, force_N + kiss_offset_N), &inv->current_mA);
+}
+
+/* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
+static bool nonzero(float x) { return (x < 0.0f) || (x > 0.0f); }
+
+/* The adaptation's correction (DESIGN 12) if every field is in its range, else none. */
+static wc_model_correction_t accept_correction(const wc_model_correction_t *c)
+{
+    const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
+    const bool valid = (c->friction_scale_delta >= -WC_CORRECTION_SCALE_MAX) &&
+                       (c->friction_scale_delta <= WC_CORRECTION_SCALE_MAX) &&
+                       (c->film_factor_delta >= WC_CORRECTION_FILM_DELTA_MIN) &&
+                       (c->film_factor_delta <= WC_CORRECTION_FILM_DELTA_MAX) &&
+                       (c->kiss_offset_N >= -WC_CORRECTION_KISS_MAX_N) && (c->kiss_offset_N <= WC_CORRECTION_KISS_MAX_N);
+    return valid ? *c : none;
+}
+
+/* DESIGN 12: the inverse's contact force commanded with the learned kiss
+ * point: the current of the pressure of F + offset, in the solenoid's range. */
+static wc_status_t shift_kiss(const wc_calibration_t *cal, float kiss_offset_N, wc_inverse_t *inv)
+{
+    inv->pressure_Pa = wc_piston_pressure_Pa(cal, inv->force_N + kiss_offset_N);
+    return wc_vfs_current_mA(cal, inv->pressure_Pa, &inv->current_mA);
 }
 
 wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_step_output_t *out)
@@ -127,7 +151,15 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     WC_ASSERT(wc_theta_valid(out->theta_degC));
     wc_torque_point_t point;
     wc_torque_point(model, u->slip_rad_s, out->theta_degC, &point);
-    const float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
+    float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
+    const wc_model_correction_t correction = accept_correction(&in->correction);
+    if (nonzero(correction.friction_scale_delta)) {
+        /* DESIGN 12: the learned friction scale corrects mu_f (eq. 18), kinetic and static */
+        const float scale = 1.0f + correction.friction_scale_delta;
+        point.mu_f *= scale;
+        point.coulomb_Nm_per_N *= scale;
+        static_Nm_per_N *= scale;
+    }
     wc_inverse_t inv;
     uint32_t film_segment = WC_FILM_NO_SEGMENT;  /* of the commanded force: where the lookups below start */
     if ((in->mode == WC_MODE_TORQUE) && clutch->lockup.locked) {
@@ -142,16 +174,24 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
+    if ((in->mode == WC_MODE_TORQUE) && nonzero(correction.kiss_offset_N)) {
+        status |= shift_kiss(model->cal, correction.kiss_offset_N, &inv);
+    }
     /* DESIGN 9: the asperity contact of the film state, once per period: the
      * lead, the torque and the film's advance share it. */
     const bool film = model->film_damping_m4 > 0.0f;
+    /* the squeeze film's damping at this viscosity, times the learned film factor (DESIGN 9, 12) */
+    const float damping_N_s_m2 = model->film_damping_m4 * (1.0f + correction.film_factor_delta) * point.viscosity_Pa_s;
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
     const wc_lag_compensation_t *lag = &in->lag_compensation;
     const bool lead = (in->mode == WC_MODE_TORQUE) && lag_time_valid(lag->time_s) && (lag->vfs_gain > 0.0f) &&
                       (lag->vfs_gain <= FLT_MAX);  /* also NaN: off */
-    if (lead && film) { lead_film(model, hbar_m, contact.pressure_Pa, point.viscosity_Pa_s, lag->time_s, film_segment, &inv); }
+    if (lead && film) {
+        lead_film(model, hbar_m, contact.pressure_Pa, damping_N_s_m2, lag->time_s, film_segment,
+                  correction.kiss_offset_N, &inv);
+    }
     out->pressure_command_Pa = model->cal->vfs_gain_Pa_per_mA * inv.current_mA;  /* the pressure wanted */
     if (lead) { status |= lead_lag(model, clutch->pressure_model_Pa, lag->vfs_gain, &inv); }
     out->current_mA = inv.current_mA;
@@ -161,6 +201,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
+    if (nonzero(correction.kiss_offset_N)) {
+        /* DESIGN 12: the learned kiss point; within [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
+        const float moved_N = force_N - correction.kiss_offset_N;
+        force_N = (moved_N > 0.0f) ? ((moved_N < WC_FORCE_MAX_N) ? moved_N : WC_FORCE_MAX_N) : 0.0f;
+    }
     const bool bench_force = in->bench.valid && wc_in_range(in->bench.apply_force_N, 0.0f, WC_FORCE_MAX_N);
     const bool bench_torque = in->bench.valid &&
                               wc_in_range(in->bench.torque_Nm, -WC_TORQUE_MAX_Nm, WC_TORQUE_MAX_Nm);
@@ -183,7 +228,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         wc_torque_at_film(&point, signed_slip_rad_s, contact_N, hbar_m, &out->model);
         out->contact_force_N = contact_N;
         clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
-                                                   model->film_damping_m4 * point.viscosity_Pa_s,
+                                                   damping_N_s_m2,
                                                    cal->control_period_s, film_segment);
     } else {
         wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */

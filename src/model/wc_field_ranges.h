@@ -21,10 +21,12 @@ typedef struct {
 #define WC_FIELD_OR_ZERO 4u       /* 0 (off) is accepted as well */
 #define WC_FIELD_LOW_PREVIOUS 8u  /* the low bound is the previous field's value (checked before it) */
 
+#define WC_FIELD_MAX_COUNT 64u
+
 typedef struct {
     const wc_field_range_t *range;  /* per field, declaration order */
     const uint8_t *flags;           /* per field, WC_FIELD_* */
-    uint32_t count;                 /* fields, <= 32 */
+    uint32_t count;                 /* fields, <= WC_FIELD_MAX_COUNT */
 } wc_field_rules_t;
 
 /* Index of the first field (declaration order) outside its range, or

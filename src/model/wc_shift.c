@@ -36,19 +36,41 @@ static bool in_closed(float value, float lo, float hi) { return (value >= lo) &&
     X(theta_source, WC_SHIFT_CAL_THETA_SOURCE, WC_FIELD_INTEGER, 0.0f, (float)WC_SHIFT_THETA_OIL) \
     X(flare_slip_rad_s, WC_SHIFT_CAL_FLARE_SLIP, 0u, 0.0f, WC_SLIP_MAX_rad_s) \
     X(tie_up_factor, WC_SHIFT_CAL_TIE_UP_FACTOR, 0u, 1.0f, 10.0f) \
-    X(jerk_filter_time_s, WC_SHIFT_CAL_JERK_FILTER_TIME, WC_FIELD_OR_ZERO, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s)
+    X(jerk_filter_time_s, WC_SHIFT_CAL_JERK_FILTER_TIME, WC_FIELD_OR_ZERO, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(adaptation, WC_SHIFT_CAL_ADAPTATION, WC_FIELD_INTEGER, 0.0f, 1.0f) \
+    X(adapt_theta_node_degC[0], WC_SHIFT_CAL_ADAPT_THETA_NODE0, 0u, WC_THETA_MIN_degC, WC_THETA_MAX_degC) \
+    X(adapt_theta_node_degC[1], WC_SHIFT_CAL_ADAPT_THETA_NODE1, WC_FIELD_LOW_PREVIOUS | WC_FIELD_LOW_OPEN, 0.0f, WC_THETA_MAX_degC) \
+    X(adapt_theta_node_degC[2], WC_SHIFT_CAL_ADAPT_THETA_NODE2, WC_FIELD_LOW_PREVIOUS | WC_FIELD_LOW_OPEN, 0.0f, WC_THETA_MAX_degC) \
+    X(adapt_theta_node_degC[3], WC_SHIFT_CAL_ADAPT_THETA_NODE3, WC_FIELD_LOW_PREVIOUS | WC_FIELD_LOW_OPEN, 0.0f, WC_THETA_MAX_degC) \
+    X(adapt_theta_node_degC[4], WC_SHIFT_CAL_ADAPT_THETA_NODE4, WC_FIELD_LOW_PREVIOUS | WC_FIELD_LOW_OPEN, 0.0f, WC_THETA_MAX_degC) \
+    X(adapt_scale_band, WC_SHIFT_CAL_ADAPT_SCALE_BAND, WC_FIELD_LOW_OPEN, 0.0f, WC_CORRECTION_SCALE_MAX) \
+    X(adapt_scale_step, WC_SHIFT_CAL_ADAPT_SCALE_STEP, 0u, 0.0f, WC_CORRECTION_SCALE_MAX) \
+    X(adapt_scale_gain, WC_SHIFT_CAL_ADAPT_SCALE_GAIN, 0u, 0.0f, 1.0f) \
+    X(adapt_confidence_gain, WC_SHIFT_CAL_ADAPT_CONFIDENCE_GAIN, 0u, 0.0f, 1.0f) \
+    X(adapt_film_factor_min, WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MIN, 0u, 0.01f, 1.0f) \
+    X(adapt_film_factor_max, WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MAX, 0u, 1.0f, 1.0f + WC_CORRECTION_FILM_DELTA_MAX) \
+    X(adapt_film_step, WC_SHIFT_CAL_ADAPT_FILM_STEP, 0u, 0.0f, 1.0f) \
+    X(adapt_film_gain, WC_SHIFT_CAL_ADAPT_FILM_GAIN, 0u, 0.0f, 1.0f) \
+    X(adapt_kiss_band_Pa, WC_SHIFT_CAL_ADAPT_KISS_BAND, 0u, 0.0f, WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa) \
+    X(adapt_kiss_step_Pa, WC_SHIFT_CAL_ADAPT_KISS_STEP, 0u, 0.0f, WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa) \
+    X(adapt_kiss_gain, WC_SHIFT_CAL_ADAPT_KISS_GAIN, 0u, 0.0f, 1.0f) \
+    X(adapt_window_skip_s, WC_SHIFT_CAL_ADAPT_WINDOW_SKIP, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(adapt_film_window_s, WC_SHIFT_CAL_ADAPT_FILM_WINDOW, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(adapt_min_slip_drop, WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP, 0u, 0.0f, 1.0f) \
+    X(adapt_min_conditioning, WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING, 0u, 0.0f, 1.0f)
 
 #define WC_SHIFT_RANGE(member, code, flags, low, high) { (low), (high) },
 #define WC_SHIFT_FLAGS(member, code, flags, low, high) (uint8_t)(flags),
 /* Field i fails with code WC_SHIFT_CAL_TURBINE_INERTIA + i: each field sits at its code's word. */
 #define WC_SHIFT_AT_ITS_CODE(member, code, flags, low, high) \
     WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, member) == 4u * (size_t)((code) - WC_SHIFT_CAL_TURBINE_INERTIA), \
-                     shift_##member##_sits_at_its_code);
+                     shift_##code##_sits_at_its_code);
 
 static const wc_field_range_t field_range[] = { WC_SHIFT_FIELD_RANGES(WC_SHIFT_RANGE) };
 static const uint8_t field_flags[] = { WC_SHIFT_FIELD_RANGES(WC_SHIFT_FLAGS) };
 static const wc_field_rules_t field_rules = { field_range, field_flags, sizeof field_flags };
 WC_SHIFT_FIELD_RANGES(WC_SHIFT_AT_ITS_CODE)
+WC_STATIC_ASSERT(WC_ADAPT_NODES == 5u, one_range_per_adaptation_node);
 WC_STATIC_ASSERT(sizeof field_flags == (size_t)(WC_SHIFT_CAL_ERRORS - WC_SHIFT_CAL_TURBINE_INERTIA), one_range_per_code);
 WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == sizeof field_flags * 4u, every_field_has_a_range);
 
@@ -64,7 +86,9 @@ void wc_shift_init(wc_shift_t *shift)
     WC_ASSERT(shift != NULL);
     if (shift == NULL) { return; }
     static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u, 0u,
-                                     { 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u } };
+                                     { 0.0f, 0.0f },
+                                     { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u,
+                                       { 0u, 0u, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f } } };
     *shift = idle;
 }
 
@@ -148,9 +172,10 @@ static bool command_valid(const wc_shift_calibration_t *cal, const wc_shift_comm
 }
 
 static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s,
-                  const wc_lag_compensation_t *lag)
+                  const wc_lag_compensation_t *lag, wc_adapt_t *adapt)
 {
     wc_shift_init(shift);
+    wc_adapt_begin(adapt);  /* a new window (NULL: none) */
     shift->lag_compensation = *lag;  /* its exponential once per shift, not per step */
     shift->last_request = true;
     shift->turbine_torque_Nm = command->turbine_torque_Nm;
@@ -222,7 +247,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
  * compensation, temperature source). saturated: the last step's output was. */
 static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                          bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
-                         wc_step_input_t *in)
+                         wc_adapt_t *adapt, wc_step_input_t *in)
 {
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
@@ -237,7 +262,7 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
         if (command_valid(cal, command)) {
             const wc_lag_compensation_t lag = wc_lag_compensation(clutch, cal->lag_compensation_time_s);
-            start(shift, command, slip_rad_s, &lag);
+            start(shift, command, slip_rad_s, &lag, adapt);
         } else {  /* nothing of the command is kept (it may hold NaN) */
             wc_shift_init(shift);
             shift->last_request = true;
@@ -253,7 +278,16 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
     in->carried_torque_Nm = 0.0f;
     in->lag_compensation = shift->lag_compensation;
     in->theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
+    const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
+    in->correction = none;
     if (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
+        if (cal->adaptation == 1u) {
+            /* DESIGN 12: the learned values at the temperature the model uses this step */
+            const float theta_degC = in->theta_from_oil ? (wc_theta_valid(in->theta_oil_degC) ? in->theta_oil_degC
+                                                                                               : clutch->held.theta_oil_degC)
+                                                        : clutch->theta_degC;
+            in->correction = wc_adapt_correction(adapt, cal, clutch, theta_degC);
+        }
         const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
         /* once synchronous the clutch carries what the driveline model says
          * (the feed-forward at a zero slip rate), not the request */
@@ -271,11 +305,17 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
 /* After the clutch step: the lock-up decides the inertia phase's end, the
  * quality vector, the report. Returns true when the shift ended. */
 static bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
-                        const wc_step_output_t *out, wc_shift_report_t *report, uint32_t phase_before,
-                        float slip_rad_s, float dt_s)
+                        wc_adapt_t *adapt, const wc_step_output_t *out, wc_shift_report_t *report,
+                        uint32_t phase_before, float slip_rad_s, float dt_s)
 {
     const uint32_t phase_stepped = shift->phase;
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
+    if ((shift->phase == (uint32_t)WC_SHIFT_INERTIA) && (cal->adaptation == 1u)) {
+        /* DESIGN 12: the window's sample of this period (its torque against the slip's change) */
+        const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
+        wc_adapt_sample(adapt, cal, (float)shift->phase_periods * dt_s, slip_rad_s, d.drive_rad_s2,
+                        d.inverse_inertia, clutch, out);
+    }
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
         const wc_calibration_t *clutch_cal = clutch->model.cal;
@@ -326,13 +366,15 @@ static bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, co
     if (ended) {
         shift->report.slip_rmse_rad_s = (shift->inertia_periods > 0u)
                                             ? sqrtf(shift->error_sq_sum / (float)shift->inertia_periods) : 0.0f;
+        /* DESIGN 12: learn from the shift (only a valid one changes anything) */
+        shift->report.adaptation = wc_adapt_finish(adapt, cal, shift->report.abort_reason, clutch);
         *report = shift->report;
     }
     return ended;
 }
 
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                   bool safe, wc_clutch_t *clutch, wc_step_input_t *in, wc_step_output_t *out,
+                   bool safe, wc_clutch_t *clutch, wc_adapt_t *adapt, wc_step_input_t *in, wc_step_output_t *out,
                    wc_shift_report_t *report)
 {
     WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (in != NULL) &&
@@ -346,7 +388,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     /* the measured slip, or while it is invalid the clutch's last valid one */
     const float slip_rad_s = wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
     const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
-    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, in);
+    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in);
     (void)wc_clutch_step(clutch, in, out);
-    return shift_after(shift, cal, clutch, out, report, phase_before, slip_rad_s, dt_s);
+    return shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
 }

@@ -18,6 +18,7 @@ const wc_tcu_shift_calibration_t wc_tcu_shift_calibrations[] = {
     {"shift_1_2_blind", &wc_shift_1_2_blind},        /* (b) 2-DOF, thermal-blind */
     {"shift_1_2_feedback", &wc_shift_1_2_feedback},  /* (a) PI only */
     {"shift_1_2_nolag", &wc_shift_1_2_nolag},        /* (c) without lag compensation */
+    {"shift_1_2_adaptive", &wc_shift_1_2_adaptive},  /* (c) with adaptation (DESIGN 12) */
 };
 const size_t wc_tcu_shift_calibration_count = sizeof wc_tcu_shift_calibrations / sizeof wc_tcu_shift_calibrations[0];
 

@@ -59,7 +59,33 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(flare_slip_rad_s, WC_SHIFT_CAL_FLARE_SLIP, 0.0f, WC_SLIP_MAX_rad_s, false),
     SHIFT_FIELD(tie_up_factor, WC_SHIFT_CAL_TIE_UP_FACTOR, 1.0f, 10.0f, false),
     SHIFT_FIELD(jerk_filter_time_s, WC_SHIFT_CAL_JERK_FILTER_TIME, 1e-3f, WC_SHIFT_LIMIT_TIME_MAX_s, true),
+    /* adaptation (DESIGN 12); adaptation, the nodes and the scale band are tested on their own */
+    SHIFT_FIELD(adapt_scale_step, WC_SHIFT_CAL_ADAPT_SCALE_STEP, 0.0f, WC_CORRECTION_SCALE_MAX, false),
+    SHIFT_FIELD(adapt_scale_gain, WC_SHIFT_CAL_ADAPT_SCALE_GAIN, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_confidence_gain, WC_SHIFT_CAL_ADAPT_CONFIDENCE_GAIN, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_film_factor_min, WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MIN, 0.01f, 1.0f, false),
+    SHIFT_FIELD(adapt_film_factor_max, WC_SHIFT_CAL_ADAPT_FILM_FACTOR_MAX, 1.0f, 1.0f + WC_CORRECTION_FILM_DELTA_MAX, false),
+    SHIFT_FIELD(adapt_film_step, WC_SHIFT_CAL_ADAPT_FILM_STEP, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_film_gain, WC_SHIFT_CAL_ADAPT_FILM_GAIN, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_kiss_band_Pa, WC_SHIFT_CAL_ADAPT_KISS_BAND, 0.0f, WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa, false),
+    SHIFT_FIELD(adapt_kiss_step_Pa, WC_SHIFT_CAL_ADAPT_KISS_STEP, 0.0f, WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa, false),
+    SHIFT_FIELD(adapt_kiss_gain, WC_SHIFT_CAL_ADAPT_KISS_GAIN, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_window_skip_s, WC_SHIFT_CAL_ADAPT_WINDOW_SKIP, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
+    SHIFT_FIELD(adapt_film_window_s, WC_SHIFT_CAL_ADAPT_FILM_WINDOW, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
+    SHIFT_FIELD(adapt_min_slip_drop, WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP, 0.0f, 1.0f, false),
+    SHIFT_FIELD(adapt_min_conditioning, WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING, 0.0f, 1.0f, false),
 };
+
+/* The fields with a rule of their own (test_calibration_adaptation_rules): the
+ * integer theta_source and adaptation, the strictly increasing nodes, the
+ * scale band (open at 0). */
+static bool tested_on_its_own(int code)
+{
+    return (code == (int)WC_SHIFT_CAL_THETA_SOURCE) || (code == (int)WC_SHIFT_CAL_ADAPTATION) ||
+           ((code >= (int)WC_SHIFT_CAL_ADAPT_THETA_NODE0) && (code <= (int)WC_SHIFT_CAL_ADAPT_THETA_NODE4)) ||
+           (code == (int)WC_SHIFT_CAL_ADAPT_SCALE_BAND);
+}
+#define ON_ITS_OWN_WORDS (2u + WC_ADAPT_NODES + 1u)
 
 static float *shift_field_ptr(wc_shift_calibration_t *cal, size_t offset)
 {
@@ -96,14 +122,14 @@ static void test_calibration_every_code_tested(void **state)
 {
     (void)state;
     for (int code = (int)WC_SHIFT_CAL_TURBINE_INERTIA; code < (int)WC_SHIFT_CAL_ERRORS; ++code) {
-        unsigned uses = (code == (int)WC_SHIFT_CAL_THETA_SOURCE) ? 1u : 0u;
+        unsigned uses = tested_on_its_own(code) ? 1u : 0u;
         for (size_t i = 0u; i < WC_TEST_COUNT(shift_fields); ++i) {
             if ((int)shift_fields[i].code == code) { uses++; }
         }
         WC_CHECK(uses == 1u, "error code %d is tested by %u fields", code, uses);
     }
     /* the float fields and theta_source cover the whole struct */
-    WC_CHECK(sizeof(wc_shift_calibration_t) == (WC_TEST_COUNT(shift_fields) + 1u) * sizeof(float),
+    WC_CHECK(sizeof(wc_shift_calibration_t) == (WC_TEST_COUNT(shift_fields) + ON_ITS_OWN_WORDS) * sizeof(float),
              "wc_shift_calibration_t has %zu bytes: a field without a test?", sizeof(wc_shift_calibration_t));
 }
 
@@ -135,6 +161,46 @@ static void test_calibration_each_field_rejected(void **state)
         cal.theta_source = bad_source[k];
         assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_THETA_SOURCE);
     }
+}
+
+/* DESIGN 12: adaptation 0 or 1; the nodes within the thermal envelope and
+ * strictly increasing (a node equal to the one before it is rejected with its
+ * own code); the scale band in (0, WC_CORRECTION_SCALE_MAX]. */
+static void test_calibration_adaptation_rules(void **state)
+{
+    (void)state;
+    wc_shift_calibration_t cal = test_cal;
+    cal.adaptation = 1u;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
+    cal.adaptation = 2u;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_ADAPTATION);
+    for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
+        const wc_shift_cal_error_t code = (wc_shift_cal_error_t)((uint32_t)WC_SHIFT_CAL_ADAPT_THETA_NODE0 + i);
+        const float bad[] = { NAN, INFINITY, -INFINITY, WC_THETA_MAX_degC + 1.0f, WC_THETA_MIN_degC - 1.0f };
+        for (size_t k = 0u; k < WC_TEST_COUNT(bad); ++k) {
+            cal = test_cal;
+            cal.adapt_theta_node_degC[i] = bad[k];
+            WC_CHECK(wc_shift_calibration_check(&cal) == code, "node %u = %g", (unsigned)i, (double)bad[k]);
+        }
+        if (i > 0u) {  /* equal to the node before: not strictly increasing */
+            cal = test_cal;
+            cal.adapt_theta_node_degC[i] = cal.adapt_theta_node_degC[i - 1u];
+            WC_CHECK(wc_shift_calibration_check(&cal) == code, "node %u equal to its predecessor", (unsigned)i);
+        }
+    }
+    const float nodes_ok[WC_ADAPT_NODES] = { WC_THETA_MIN_degC, 0.0f, 100.0f, 200.0f, WC_THETA_MAX_degC };
+    cal = test_cal;
+    for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) { cal.adapt_theta_node_degC[i] = nodes_ok[i]; }
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
+    const float band_bad[] = { 0.0f, -0.1f, nextafterf(WC_CORRECTION_SCALE_MAX, 1.0f), NAN };
+    for (size_t k = 0u; k < WC_TEST_COUNT(band_bad); ++k) {
+        cal = test_cal;
+        cal.adapt_scale_band = band_bad[k];
+        WC_CHECK(wc_shift_calibration_check(&cal) == WC_SHIFT_CAL_ADAPT_SCALE_BAND, "band %g", (double)band_bad[k]);
+    }
+    cal = test_cal;
+    cal.adapt_scale_band = WC_CORRECTION_SCALE_MAX;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
 }
 
 static void test_calibration_limits_inclusive(void **state)
@@ -313,6 +379,7 @@ int main(void)
         cmocka_unit_test(test_calibration_every_code_tested),
         cmocka_unit_test(test_calibration_each_field_rejected),
         cmocka_unit_test(test_calibration_limits_inclusive),
+        cmocka_unit_test(test_calibration_adaptation_rules),
         cmocka_unit_test(test_reference_ends),
         cmocka_unit_test(test_reference_monotone_and_rate),
         cmocka_unit_test(test_feedforward_formula),

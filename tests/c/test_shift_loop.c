@@ -5,6 +5,9 @@
  * after a shift, leaving Shift mode, Mode 3 without a shift calibration. */
 #include "wc_test_shift_harness.h"
 
+/* A step in which a shift ends: the cyclic frames and ShiftReport (adaptation off: no AdaptationReport). */
+#define REPORT_FRAMES (WC_LOOP_TX_CYCLIC + 1u)
+
 #include "wc_table1_calibration.h"
 #include "wetclutch_can/wc_loop.h"
 
@@ -56,13 +59,13 @@ static void loop_period(loop_sim_t *l, bool sensors, int mode, int shift_request
     memset(l->out, 0xA5, sizeof l->out);
     l->n = wc_loop_step(&l->loop, l->out);
     l->steps++;
-    WC_CHECK((l->n == WC_LOOP_TX_CYCLIC) || (l->n == WC_LOOP_TX_FRAMES), "%u frames", (unsigned)l->n);
+    WC_CHECK((l->n == WC_LOOP_TX_CYCLIC) || (l->n == REPORT_FRAMES), "%u frames", (unsigned)l->n);
     assert_int_equal(l->out[0].id, WC_CAN_VFS_COMMAND_FRAME_ID);
     assert_int_equal(l->out[1].id, WC_CAN_CLUTCH_ESTIMATE_FRAME_ID);
     wc_can_vfs_command_phys_t vfs;
     assert_true(wc_can_decode_vfs_command(&vfs, l->out[0].data, l->out[0].dlc) <= WC_CAN_SATURATED);
     l->vfs = vfs;
-    if (l->n == WC_LOOP_TX_FRAMES) {
+    if (l->n == REPORT_FRAMES) {
         assert_int_equal(l->out[2].id, WC_CAN_SHIFT_REPORT_FRAME_ID);
         assert_int_equal(l->out[2].dlc, WC_CAN_SHIFT_REPORT_LENGTH);
         assert_int_equal(l->out[2].flags, 0u);
@@ -109,7 +112,7 @@ static void test_loop_shift_report(void **state)
     uint32_t report_step = 0u;
     for (int k = 0; k < 2000; ++k) {
         loop_period(&l, true, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, 1);
-        if (l.n == WC_LOOP_TX_FRAMES) { report_step = l.steps; }
+        if (l.n == REPORT_FRAMES) { report_step = l.steps; }
         WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) == 0u, "safe state during the shift");
     }
     assert_int_equal(l.reports, 1u);
@@ -156,7 +159,7 @@ static void test_loop_shift_command_stale(void **state)
             WC_CHECK((l.vfs.status & WC_CAN_STATUS_SAFE_STATE_ACTIVE) != 0u, "timeout without the safe state");
             WC_CHECK(fabsf(l.vfs.vfs_current_mA - wc_table1_calibration.vfs_current_min_mA) <= 0.5f,
                      "safe state current %g mA", (double)l.vfs.vfs_current_mA);
-            assert_int_equal(l.n, WC_LOOP_TX_FRAMES);  /* the aborted shift's report, in the same step */
+            assert_int_equal(l.n, REPORT_FRAMES);  /* the aborted shift's report, in the same step */
             assert_int_equal(l.last_report.abort_reason, WC_SHIFT_ABORT_INPUT_LOST);
         }
     }

@@ -66,7 +66,18 @@
         .flare_slip_rad_s = 10.0f,                                                                             \
         .tie_up_factor = 1.5f,                                                                                 \
         .jerk_filter_time_s = 0.02f,                                                                           \
+        WC_TEST_ADAPTATION_RULES(0u)                                                                           \
     }
+
+/* The adaptation's rules of the test calibrations (DESIGN 12; the values of
+ * tools/calibrations/shift_1_2.toml), adaptation on (1u) or off (0u). */
+#define WC_TEST_ADAPTATION_RULES(on)                                                                           \
+    .adaptation = (on), .adapt_theta_node_degC = { 40.0f, 80.0f, 120.0f, 160.0f, 200.0f },                    \
+    .adapt_scale_band = 0.3f, .adapt_scale_step = 0.05f, .adapt_scale_gain = 0.6f,                            \
+    .adapt_confidence_gain = 0.3f, .adapt_film_factor_min = 0.2f, .adapt_film_factor_max = 5.0f,              \
+    .adapt_film_step = 0.3f, .adapt_film_gain = 0.5f, .adapt_kiss_band_Pa = 60e3f,                            \
+    .adapt_kiss_step_Pa = 10e3f, .adapt_kiss_gain = 0.5f, .adapt_window_skip_s = 0.03f,                       \
+    .adapt_film_window_s = 0.1f, .adapt_min_slip_drop = 0.5f, .adapt_min_conditioning = 0.05f,
 
 /* Periods in Shift mode with ShiftRequest 0 after wc_loop_init with
  * WC_LOOP_CONFIG_DEFAULT, enough to leave the safe state (E2E sync and
@@ -126,7 +137,7 @@ static inline wc_can_result_t wc_test_shift_command_frame(wc_can_frame_t *frame,
                                                           float turbine_torque_Nm, float target_ms, uint8_t alive)
 {
     *frame = wc_test_can_frame(WC_CAN_SHIFT_COMMAND_FRAME_ID);
-    const wc_can_shift_command_phys_t c = { request ? 1.0f : 0.0f, 2.0f, turbine_torque_Nm, target_ms, alive };
+    const wc_can_shift_command_phys_t c = { request ? 1.0f : 0.0f, 0.0f, 2.0f, turbine_torque_Nm, target_ms, alive };
     return wc_can_encode_shift_command(frame->data, &c, sizeof frame->data);
 }
 

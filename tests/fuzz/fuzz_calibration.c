@@ -256,7 +256,7 @@ static void evaluate(const wc_calibration_t *c)
             for (size_t q = 0u; q < N_REQUESTS; ++q) {
                 for (size_t m = 0u; m < 3u; ++m) {
                     const wc_step_input_t in = { slips[s], thetas[k], thetas[k], requests[q], modes[m],
-                                                 { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f };
+                                                 { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f } };
                     fz_context("wc_clutch_step(slip, oil = housing, request; mode)", ++n);
                     fz_arg(slips[s]); fz_arg(thetas[k]); fz_arg(requests[q]);
                     fz_ctx.iargs[0] = (long)modes[m];

@@ -127,7 +127,8 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     const bool shift = h->shift && (f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID);
     if (h->plausible && (fault != 3u) && shift) {
         const wc_can_shift_command_phys_t s = {
-            (float)(fz_u8(r) & 1u), (float)(fz_u8(r) % 8u + 1u), map_u16(fz_u16(r), -1000.0f, 1000.0f),
+            (float)(fz_u8(r) & 1u), (float)(fz_u8(r) & 1u) /* AdaptationReset */, (float)(fz_u8(r) % 8u + 1u),
+            map_u16(fz_u16(r), -1000.0f, 1000.0f),
             map_u16(fz_u16(r), 50.0f, 2000.0f), 0u };
         (void)wc_can_encode_shift_command(f->data, &s, sizeof f->data);
     } else if (h->plausible && (fault != 3u) && (sensors || request || bench)) {

@@ -330,6 +330,7 @@ int wc_can_shift_command_pack(
     dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
     dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
     dst_p[1] |= pack_left_shift_u8(src_p->shift_request, 4u, 0x10u);
+    dst_p[1] |= pack_left_shift_u8(src_p->adaptation_reset, 5u, 0x20u);
     dst_p[2] |= pack_left_shift_u8(src_p->target_gear, 0u, 0x0fu);
     turbine_torque = (uint16_t)src_p->turbine_torque;
     dst_p[3] |= pack_left_shift_u16(turbine_torque, 0u, 0xffu);
@@ -354,6 +355,7 @@ int wc_can_shift_command_unpack(
     dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
     dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
     dst_p->shift_request = unpack_right_shift_u8(src_p[1], 4u, 0x10u);
+    dst_p->adaptation_reset = unpack_right_shift_u8(src_p[1], 5u, 0x20u);
     dst_p->target_gear = unpack_right_shift_u8(src_p[2], 0u, 0x0fu);
     turbine_torque = unpack_right_shift_u16(src_p[3], 0u, 0xffu);
     turbine_torque |= unpack_left_shift_u16(src_p[4], 8u, 0xffu);
@@ -401,6 +403,16 @@ bool wc_can_shift_command_shift_request_is_in_range(uint8_t value)
 }
 
 bool wc_can_shift_command_shift_request_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_shift_command_adaptation_reset_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_shift_command_adaptation_reset_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 1.0f));
 }
@@ -958,6 +970,181 @@ bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value)
 bool wc_can_shift_report_abort_reason_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 6.0f));
+}
+
+int wc_can_adaptation_report_pack(
+    uint8_t *dst_p,
+    const struct wc_can_adaptation_report_t *src_p,
+    size_t size)
+{
+    uint16_t friction_scale_change;
+    uint16_t kiss_offset;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->result, 0u, 0x07u);
+    dst_p[0] |= pack_left_shift_u8(src_p->node, 3u, 0x38u);
+    dst_p[0] |= pack_left_shift_u8(src_p->image_missing, 6u, 0x40u);
+    dst_p[0] |= pack_left_shift_u8(src_p->image_invalid, 7u, 0x80u);
+    dst_p[1] |= pack_left_shift_u16(src_p->friction_scale, 0u, 0xffu);
+    dst_p[2] |= pack_right_shift_u16(src_p->friction_scale, 8u, 0x0fu);
+    friction_scale_change = (uint16_t)src_p->friction_scale_change;
+    dst_p[2] |= pack_left_shift_u16(friction_scale_change, 4u, 0xf0u);
+    dst_p[3] |= pack_right_shift_u16(friction_scale_change, 4u, 0xffu);
+    dst_p[4] |= pack_left_shift_u8(src_p->confidence, 0u, 0x7fu);
+    dst_p[4] |= pack_left_shift_u16(src_p->film_factor, 7u, 0x80u);
+    dst_p[5] |= pack_right_shift_u16(src_p->film_factor, 1u, 0xffu);
+    dst_p[6] |= pack_right_shift_u16(src_p->film_factor, 9u, 0x07u);
+    kiss_offset = (uint16_t)src_p->kiss_offset;
+    dst_p[6] |= pack_left_shift_u16(kiss_offset, 3u, 0xf8u);
+    dst_p[7] |= pack_right_shift_u16(kiss_offset, 5u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_adaptation_report_unpack(
+    struct wc_can_adaptation_report_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    uint16_t friction_scale_change;
+    uint16_t kiss_offset;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->result = unpack_right_shift_u8(src_p[0], 0u, 0x07u);
+    dst_p->node = unpack_right_shift_u8(src_p[0], 3u, 0x38u);
+    dst_p->image_missing = unpack_right_shift_u8(src_p[0], 6u, 0x40u);
+    dst_p->image_invalid = unpack_right_shift_u8(src_p[0], 7u, 0x80u);
+    dst_p->friction_scale = unpack_right_shift_u16(src_p[1], 0u, 0xffu);
+    dst_p->friction_scale |= unpack_left_shift_u16(src_p[2], 8u, 0x0fu);
+    friction_scale_change = unpack_right_shift_u16(src_p[2], 4u, 0xf0u);
+    friction_scale_change |= unpack_left_shift_u16(src_p[3], 4u, 0xffu);
+
+    if ((friction_scale_change & (1u << 11)) != 0u) {
+        friction_scale_change |= 0xf000u;
+    }
+
+    dst_p->friction_scale_change = (int16_t)friction_scale_change;
+    dst_p->confidence = unpack_right_shift_u8(src_p[4], 0u, 0x7fu);
+    dst_p->film_factor = unpack_right_shift_u16(src_p[4], 7u, 0x80u);
+    dst_p->film_factor |= unpack_left_shift_u16(src_p[5], 1u, 0xffu);
+    dst_p->film_factor |= unpack_left_shift_u16(src_p[6], 9u, 0x07u);
+    kiss_offset = unpack_right_shift_u16(src_p[6], 3u, 0xf8u);
+    kiss_offset |= unpack_left_shift_u16(src_p[7], 5u, 0xffu);
+
+    if ((kiss_offset & (1u << 12)) != 0u) {
+        kiss_offset |= 0xe000u;
+    }
+
+    dst_p->kiss_offset = (int16_t)kiss_offset;
+
+    return (0);
+}
+
+int wc_can_adaptation_report_init(struct wc_can_adaptation_report_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_adaptation_report_t));
+
+    return 0;
+}
+
+bool wc_can_adaptation_report_result_is_in_range(uint8_t value)
+{
+    return (value <= 5u);
+}
+
+bool wc_can_adaptation_report_result_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 5.0f));
+}
+
+bool wc_can_adaptation_report_node_is_in_range(uint8_t value)
+{
+    return (value <= 4u);
+}
+
+bool wc_can_adaptation_report_node_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4.0f));
+}
+
+bool wc_can_adaptation_report_image_missing_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_adaptation_report_image_missing_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_adaptation_report_image_invalid_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_adaptation_report_image_invalid_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_adaptation_report_friction_scale_is_in_range(uint16_t value)
+{
+    return (value <= 4000u);
+}
+
+bool wc_can_adaptation_report_friction_scale_is_in_phys_range(float value)
+{
+    return ((value >= 0.5f) && (value <= 1.5f));
+}
+
+bool wc_can_adaptation_report_friction_scale_change_is_in_range(int16_t value)
+{
+    return ((value >= -2000) && (value <= 2000));
+}
+
+bool wc_can_adaptation_report_friction_scale_change_is_in_phys_range(float value)
+{
+    return ((value >= -0.5f) && (value <= 0.5f));
+}
+
+bool wc_can_adaptation_report_confidence_is_in_range(uint8_t value)
+{
+    return (value <= 100u);
+}
+
+bool wc_can_adaptation_report_confidence_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_adaptation_report_film_factor_is_in_range(uint16_t value)
+{
+    return (value <= 4000u);
+}
+
+bool wc_can_adaptation_report_film_factor_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 20.0f));
+}
+
+bool wc_can_adaptation_report_kiss_offset_is_in_range(int16_t value)
+{
+    return ((value >= -4000) && (value <= 4000));
+}
+
+bool wc_can_adaptation_report_kiss_offset_is_in_phys_range(float value)
+{
+    return ((value >= -1000.0f) && (value <= 1000.0f));
 }
 
 int wc_can_bench_measurement_pack(

@@ -26,6 +26,10 @@ const wc_can_signal_t wc_can_sig_shift_command_shift_request = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
+const wc_can_signal_t wc_can_sig_shift_command_adaptation_reset = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
 const wc_can_signal_t wc_can_sig_shift_command_target_gear = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 1, .raw_max = 8,
     .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_GEAR_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_GEAR_SNA_CHOICE, .has_sna = true,
@@ -88,6 +92,42 @@ const wc_can_signal_t wc_can_sig_shift_report_flare = {
 };
 const wc_can_signal_t wc_can_sig_shift_report_tie_up = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_result = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 5,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_node = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 4,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_image_missing = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_image_invalid = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale = {
+    .scale = 0.00025f, .offset = 0.5f, .raw_min = 0, .raw_max = 4000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale_change = {
+    .scale = 0.00025f, .offset = 0.0f, .raw_min = -2000, .raw_max = 2000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_confidence = {
+    .scale = 0.01f, .offset = 0.0f, .raw_min = 0, .raw_max = 100,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_film_factor = {
+    .scale = 0.005f, .offset = 0.0f, .raw_min = 0, .raw_max = 4000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_adaptation_report_kiss_offset = {
+    .scale = 0.25f, .offset = 0.0f, .raw_min = -4000, .raw_max = 4000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
 const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force = {
@@ -222,6 +262,7 @@ wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_com
         return WC_CAN_ERR_SIZE;
     }
     msg.shift_request = (uint8_t)to_raw(&wc_can_sig_shift_command_shift_request, src->shift_request, &result);
+    msg.adaptation_reset = (uint8_t)to_raw(&wc_can_sig_shift_command_adaptation_reset, src->adaptation_reset, &result);
     msg.target_gear = (uint8_t)to_raw(&wc_can_sig_shift_command_target_gear, src->target_gear, &result);
     msg.turbine_torque = (int16_t)to_raw(&wc_can_sig_shift_command_turbine_torque, src->turbine_torque_Nm, &result);
     msg.target_inertia_time = (uint16_t)to_raw(&wc_can_sig_shift_command_target_inertia_time, src->target_inertia_time_ms, &result);
@@ -249,6 +290,7 @@ wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, co
         return WC_CAN_ERR_SIZE;
     }
     dst->shift_request = to_phys(&wc_can_sig_shift_command_shift_request, msg.shift_request, &result);
+    dst->adaptation_reset = to_phys(&wc_can_sig_shift_command_adaptation_reset, msg.adaptation_reset, &result);
     dst->target_gear = to_phys(&wc_can_sig_shift_command_target_gear, msg.target_gear, &result);
     dst->turbine_torque_Nm = to_phys(&wc_can_sig_shift_command_turbine_torque, msg.turbine_torque, &result);
     dst->target_inertia_time_ms = to_phys(&wc_can_sig_shift_command_target_inertia_time, msg.target_inertia_time, &result);
@@ -395,6 +437,54 @@ wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, cons
     if (!wc_can_shift_report_abort_reason_is_in_range(msg.abort_reason)) {
         result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
     }
+    return result;
+}
+
+/* AdaptationReport */
+
+wc_can_result_t wc_can_encode_adaptation_report(uint8_t *dst, const wc_can_adaptation_report_phys_t *src, size_t size)
+{
+    struct wc_can_adaptation_report_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ADAPTATION_REPORT_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.result = (uint8_t)to_raw(&wc_can_sig_adaptation_report_result, src->result, &result);
+    msg.node = (uint8_t)to_raw(&wc_can_sig_adaptation_report_node, src->node, &result);
+    msg.image_missing = (uint8_t)to_raw(&wc_can_sig_adaptation_report_image_missing, src->image_missing, &result);
+    msg.image_invalid = (uint8_t)to_raw(&wc_can_sig_adaptation_report_image_invalid, src->image_invalid, &result);
+    msg.friction_scale = (uint16_t)to_raw(&wc_can_sig_adaptation_report_friction_scale, src->friction_scale, &result);
+    msg.friction_scale_change = (int16_t)to_raw(&wc_can_sig_adaptation_report_friction_scale_change, src->friction_scale_change, &result);
+    msg.confidence = (uint8_t)to_raw(&wc_can_sig_adaptation_report_confidence, src->confidence, &result);
+    msg.film_factor = (uint16_t)to_raw(&wc_can_sig_adaptation_report_film_factor, src->film_factor, &result);
+    msg.kiss_offset = (int16_t)to_raw(&wc_can_sig_adaptation_report_kiss_offset, src->kiss_offset_kPa, &result);
+    if (wc_can_adaptation_report_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_adaptation_report(wc_can_adaptation_report_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_adaptation_report_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ADAPTATION_REPORT_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_adaptation_report_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->result = to_phys(&wc_can_sig_adaptation_report_result, msg.result, &result);
+    dst->node = to_phys(&wc_can_sig_adaptation_report_node, msg.node, &result);
+    dst->image_missing = to_phys(&wc_can_sig_adaptation_report_image_missing, msg.image_missing, &result);
+    dst->image_invalid = to_phys(&wc_can_sig_adaptation_report_image_invalid, msg.image_invalid, &result);
+    dst->friction_scale = to_phys(&wc_can_sig_adaptation_report_friction_scale, msg.friction_scale, &result);
+    dst->friction_scale_change = to_phys(&wc_can_sig_adaptation_report_friction_scale_change, msg.friction_scale_change, &result);
+    dst->confidence = to_phys(&wc_can_sig_adaptation_report_confidence, msg.confidence, &result);
+    dst->film_factor = to_phys(&wc_can_sig_adaptation_report_film_factor, msg.film_factor, &result);
+    dst->kiss_offset_kPa = to_phys(&wc_can_sig_adaptation_report_kiss_offset, msg.kiss_offset, &result);
     return result;
 }
 

@@ -30,6 +30,10 @@ INERTIA_TIME_MIN_S, INERTIA_TIME_MAX_S = 0.05, 5.0
 GAIN_MAX = 1e5
 TORQUE_MAX_NM = 1.0e5      # WC_TORQUE_MAX_Nm
 SLIP_MAX_RAD_S = 1047.2    # WC_SLIP_MAX_rad_s
+THETA_MIN_DEGC, THETA_MAX_DEGC = -40.0, 250.0   # WC_THETA_MIN_degC, WC_THETA_MAX_degC
+ADAPT_NODES = 5            # WC_ADAPT_NODES
+CORRECTION_SCALE_MAX = 0.5  # WC_CORRECTION_SCALE_MAX
+KISS_BAND_MAX_PA = 1e6     # WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa
 
 # (name in the file, unit, C field, check) in the C struct's order. check(value, values) -> bool.
 FIELDS: tuple[tuple[str, str, str, object], ...] = (
@@ -56,8 +60,28 @@ FIELDS: tuple[tuple[str, str, str, object], ...] = (
     ("flare_slip", "rad/s", "flare_slip_rad_s", lambda v, c: 0.0 <= v <= SLIP_MAX_RAD_S),
     ("tie_up_factor", "1", "tie_up_factor", lambda v, c: 1.0 <= v <= 10.0),
     ("jerk_filter_time", "s", "jerk_filter_time_s", lambda v, c: v == 0.0 or 1e-3 <= v <= TIME_MAX_S),
+    # Adaptation (DESIGN 12, include/wetclutch/wc_adapt.h)
+    ("adaptation", "1", "adaptation", lambda v, c: v in (0, 1)),
+    ("adapt_theta_node0", "degC", "adapt_theta_node_degC[0]", lambda v, c: THETA_MIN_DEGC <= v <= THETA_MAX_DEGC),
+    *((f"adapt_theta_node{i}", "degC", f"adapt_theta_node_degC[{i}]",
+       (lambda i: lambda v, c: c[f"adapt_theta_node{i - 1}"] < v <= THETA_MAX_DEGC)(i)) for i in range(1, ADAPT_NODES)),
+    ("adapt_scale_band", "1", "adapt_scale_band", lambda v, c: 0.0 < v <= CORRECTION_SCALE_MAX),
+    ("adapt_scale_step", "1", "adapt_scale_step", lambda v, c: 0.0 <= v <= CORRECTION_SCALE_MAX),
+    ("adapt_scale_gain", "1", "adapt_scale_gain", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_confidence_gain", "1", "adapt_confidence_gain", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_film_factor_min", "1", "adapt_film_factor_min", lambda v, c: _f32(0.01) <= v <= 1.0),
+    ("adapt_film_factor_max", "1", "adapt_film_factor_max", lambda v, c: 1.0 <= v <= 20.0),
+    ("adapt_film_step", "1", "adapt_film_step", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_film_gain", "1", "adapt_film_gain", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_kiss_band", "Pa", "adapt_kiss_band_Pa", lambda v, c: 0.0 <= v <= KISS_BAND_MAX_PA),
+    ("adapt_kiss_step", "Pa", "adapt_kiss_step_Pa", lambda v, c: 0.0 <= v <= KISS_BAND_MAX_PA),
+    ("adapt_kiss_gain", "1", "adapt_kiss_gain", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_window_skip", "s", "adapt_window_skip_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("adapt_film_window", "s", "adapt_film_window_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("adapt_min_slip_drop", "1", "adapt_min_slip_drop", lambda v, c: 0.0 <= v <= 1.0),
+    ("adapt_min_conditioning", "1", "adapt_min_conditioning", lambda v, c: 0.0 <= v <= 1.0),
 )
-INTEGER_FIELDS = ("theta_source",)
+INTEGER_FIELDS = ("theta_source", "adaptation")
 THETA_SOURCES = {0: "observer", 1: "oil"}
 
 
