@@ -27,6 +27,7 @@
 
 #include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
+#include "wc_adapt_file.h"
 #include "wc_tcu_calibrations.h"
 
 static int parse_line(const char *line, double *t_s, wc_can_frame_t *frame)
@@ -71,6 +72,13 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(kp_Nm_per_rad_s), SHIFT_FIELD(ki_Nm_per_rad), SHIFT_FIELD(integral_limit_Nm),
     SHIFT_FIELD(lag_compensation_time_s), SHIFT_FIELD(flare_slip_rad_s), SHIFT_FIELD(tie_up_factor),
     SHIFT_FIELD(jerk_filter_time_s),
+    SHIFT_FIELD(adapt_theta_node_degC[0]), SHIFT_FIELD(adapt_theta_node_degC[1]), SHIFT_FIELD(adapt_theta_node_degC[2]),
+    SHIFT_FIELD(adapt_theta_node_degC[3]), SHIFT_FIELD(adapt_theta_node_degC[4]), SHIFT_FIELD(adapt_scale_band),
+    SHIFT_FIELD(adapt_scale_step), SHIFT_FIELD(adapt_scale_gain), SHIFT_FIELD(adapt_confidence_gain),
+    SHIFT_FIELD(adapt_film_factor_min), SHIFT_FIELD(adapt_film_factor_max), SHIFT_FIELD(adapt_film_step),
+    SHIFT_FIELD(adapt_film_gain), SHIFT_FIELD(adapt_kiss_band_Pa), SHIFT_FIELD(adapt_kiss_step_Pa),
+    SHIFT_FIELD(adapt_kiss_gain), SHIFT_FIELD(adapt_window_skip_s), SHIFT_FIELD(adapt_film_window_s),
+    SHIFT_FIELD(adapt_min_slip_drop), SHIFT_FIELD(adapt_min_conditioning),
 };
 
 static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
@@ -92,12 +100,13 @@ static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
 }
 
 #define USAGE "usage: wc_replay LOG|- [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]" \
-              " [--shift NAME [--set FIELD=VALUE]...] [--lockstep]\n"
+              " [--shift NAME [--set FIELD=VALUE]... [--adaptation-file FILE]] [--lockstep]\n"
 
 int main(int argc, char **argv)
 {
     static wc_shift_calibration_t shift;  /* the loop keeps a pointer to it */
     const char *shift_name = NULL;
+    const char *adaptation_path = NULL;
     int lockstep = 0;
     const char *log_path = NULL;
     const char *calibration = "table1";
@@ -121,6 +130,9 @@ int main(int argc, char **argv)
                 fprintf(stderr, "wc_replay: --set: '%s' is not FIELD=NUMBER of a float shift calibration field\n", argv[i]);
                 return 2;
             }
+        }
+        else if ((strcmp(argv[i], "--adaptation-file") == 0) && (i + 1 < argc) && (shift_name != NULL)) {
+            adaptation_path = argv[++i];
         }
         else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; }
         else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
@@ -159,6 +171,12 @@ int main(int argc, char **argv)
     if (wc_loop_init(&loop, cal, &config, (float)theta_start_degC) != WC_CAL_OK) {
         fprintf(stderr, "wc_replay: calibration %s rejected\n", calibration);
         return 2;
+    }
+    static wc_adapt_file_t adaptation_file;  /* the loop's hook keeps a pointer to it */
+    if (adaptation_path != NULL) {
+        adaptation_file.path = adaptation_path;
+        adaptation_file.program = "wc_replay";
+        (void)wc_adapt_file_attach(&adaptation_file, &loop);
     }
     FILE *in = (strcmp(log_path, "-") == 0) ? stdin : fopen(log_path, "r");
     if (in == NULL) {

@@ -26,6 +26,7 @@
 #include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
 #include "wc_socketcan.h"
+#include "wc_adapt_file.h"
 #include "wc_tcu_calibrations.h"
 
 /* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
@@ -42,6 +43,7 @@ typedef struct {
     const char *iface;
     const char *calibration;
     const char *shift;        /* --shift NAME: shift control on (NULL: off) */
+    const char *adaptation_file;  /* --adaptation-file FILE: the learned values' image (DESIGN 12) */
     const char *stats_json;
     int64_t period_ns;
     int frame_clock;
@@ -99,6 +101,9 @@ static void usage(FILE *out)
             "  -k, --calibration NAME    compiled-in calibration (default table1; --help lists them)\n"
             "  -s, --shift NAME          shift control (TorqueRequest Mode 3, ShiftCommand) with this compiled-in\n"
             "                            shift calibration (--help lists them); default off\n"
+            "      --adaptation-file FILE  with --shift: the clutch's learned values (DESIGN 12), read at start\n"
+            "                            (missing or invalid: the calibration's values) and written atomically\n"
+            "                            whenever a shift changes them\n"
             "  -n, --steps N             stop after N steps (default: run until SIGINT/SIGTERM)\n"
             "  -I, --idle-exit S         stop once no frame has arrived for S seconds (timed from the first frame)\n"
             "  -t, --theta-start DEGC    initial clutch temperature estimate (default 40)\n"
@@ -133,7 +138,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"theta-start", required_argument, NULL, 't'}, {"stats-json", required_argument, NULL, 'j'},
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
         {"bench", no_argument, NULL, 'b'},            {"realtime", no_argument, NULL, 3},
-        {"shift", required_argument, NULL, 's'},
+        {"shift", required_argument, NULL, 's'},       {"adaptation-file", required_argument, NULL, 4},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
@@ -150,6 +155,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'p': if (parse_number(optarg, "--period-us", 50, 1e6, &v)) { return -1; } o->period_ns = (int64_t)(v * 1000.0); break;
         case 'k': o->calibration = optarg; break;
         case 's': o->shift = optarg; break;
+        case 4: o->adaptation_file = optarg; break;
         case 'n': if (parse_number(optarg, "--steps", 1, 1e12, &v)) { return -1; } o->max_steps = (uint64_t)v; break;
         case 'I': if (parse_number(optarg, "--idle-exit", 0.001, 1e6, &v)) { return -1; } o->idle_exit_s = v; break;
         case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
@@ -383,6 +389,16 @@ int main(int argc, char **argv)
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
         return 2;
+    }
+    static wc_adapt_file_t adaptation_file;  /* the loop's hook keeps a pointer to it */
+    if (opt.adaptation_file != NULL) {
+        if (opt.shift == NULL) {
+            fprintf(stderr, "wc_tcu: --adaptation-file needs --shift (the adaptation learns from shifts)\n");
+            return 2;
+        }
+        adaptation_file.path = opt.adaptation_file;
+        adaptation_file.program = "wc_tcu";
+        (void)wc_adapt_file_attach(&adaptation_file, &loop);
     }
     /* The model is discretised for the calibration's period (eq. 1 and the VFS
      * lag, exact for that dt): another step period would be a wrong model. */

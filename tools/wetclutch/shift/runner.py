@@ -54,8 +54,11 @@ def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: s
 
 
 def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s: float, seed: int,
-               target_s: float, shift_cal) -> dict:
-    """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record."""
+               target_s: float, shift_cal, inject=None) -> dict:
+    """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record.
+    inject(k, k_inertia, signals): a fault injector (the adaptation study's faults), called each period with
+    the step, the step the controller enters the inertia phase at and {frame name: its signals} before they
+    are encoded; it may change the signals in place (a DBC choice name such as "SNA" encodes its raw value)."""
     p = params
     full = p.turbine_torque_full * scenario.load
     pl = plant_mod.UpshiftPlant(p, oil_degC=scenario.oil_degC, turbine_torque_Nm=full,
@@ -74,15 +77,21 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     frames_in = []          # what the TCU received, for the reference (reference/shift.py)
     report = None
     current = 0.0
+    n_prep = int(shift_cal.prepare_time / dt + 0.5)
+    n_tp = int(shift_cal.torque_phase_time / dt + 0.5)
+    k_i = n_pre + n_prep + n_tp           # the controller enters the inertia phase at this step (wc_shift.c)
     for k in range(n):
         t = t0_s + k * dt
         s = pl.sensors()
-        frames = [enc.frame(canlog.REQUEST, TorqueRequest=0.0, Mode=canlog.MODE_SHIFT),
-                  enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=int(k >= n_pre), TargetGear=2,
-                            TurbineTorque=float(np.clip(s["turbine_torque_estimate_Nm"], -1000.0, 1000.0)),
-                            TargetInertiaTime=round(target_s * 1e3)),
-                  enc.frame(canlog.SENSORS, SlipSpeed=float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
-                            OilTemp=float(s["oil_degC"]), HousingTemp=float(s["housing_degC"]))]
+        signals = {canlog.REQUEST: {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT},
+                   canlog.SHIFT_COMMAND: {"ShiftRequest": int(k >= n_pre), "AdaptationReset": 0, "TargetGear": 2,
+                                          "TurbineTorque": float(np.clip(s["turbine_torque_estimate_Nm"], -1000.0, 1000.0)),
+                                          "TargetInertiaTime": round(target_s * 1e3)},
+                   canlog.SENSORS: {"SlipSpeed": float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
+                                    "OilTemp": float(s["oil_degC"]), "HousingTemp": float(s["housing_degC"])}}
+        if inject is not None:
+            inject(k, k_i, signals)
+        frames = [enc.frame(name, **sig) for name, sig in signals.items()]
         frames_in.append([(m.arbitration_id, bytes(m.data)) for m in frames])
         out = tcu.exchange(t, frames)
         for fid, data in out:
@@ -110,9 +119,6 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["frames_in"] = frames_in
     rec["report"] = report
     rec["command_step"] = n_pre
-    n_prep = int(shift_cal.prepare_time / dt + 0.5)
-    n_tp = int(shift_cal.torque_phase_time / dt + 0.5)
-    k_i = n_pre + n_prep + n_tp           # the controller enters the inertia phase at this step (wc_shift.c)
     rec["inertia_step"] = k_i
     start = rec["sensor_slip_rad_s"][k_i]
     ref = np.full(n, np.nan)
@@ -120,6 +126,34 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["reference_slip_rad_s"] = ref
     rec["end_theta_degC"] = float(truth["theta_clutch_degC"][-1])
     return rec
+
+
+BETWEEN_SHIFTS_S = 0.5   # back-to-back shifts: the 2->1 downshift's release between them (see _between_shifts)
+
+
+def _between_shifts(params, tcu, enc, scenario: Scenario, theta_clutch_degC: float, t0_s: float) -> tuple[float, float]:
+    """The time between two back-to-back shifts, where a vehicle's 2->1 downshift releases the on-coming
+    clutch: BETWEEN_SHIFTS_S of frames with ShiftRequest 0 and no slip (the released clutch in 2nd gear,
+    before 1st gear's slip builds up), so the TCU's VFS and film release the clutch without slip (no model
+    heat); the plant's pack cools with eq. 1 and no friction power over the same time. Without it the next
+    shift's plant starts in 1st gear at full slip while the TCU's model still holds the clutch locked,
+    and the observer takes tens of kW of drag heat that no real clutch sees (about +12 K per shift).
+    Returns the pack temperature after it and the time."""
+    cal = params.clutch_cal
+    dt = 1e-3
+    n = int(round(BETWEEN_SHIFTS_S / dt))
+    oil = scenario.oil_degC
+    housing = oil + params.housing_offset
+    for k in range(n):
+        frames = [enc.frame(canlog.REQUEST, TorqueRequest=0.0, Mode=canlog.MODE_SHIFT),
+                  enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=0, AdaptationReset=0, TargetGear=2, TurbineTorque=0.0,
+                            TargetInertiaTime=round(TARGET_INERTIA_S * 1e3)),
+                  enc.frame(canlog.SENSORS, SlipSpeed=0.0, OilTemp=oil, HousingTemp=housing)]
+        tcu.exchange(t0_s + k * dt, frames)
+    k_total = cal.oil_conductance + cal.housing_conductance
+    steady = (cal.oil_conductance * oil + cal.housing_conductance * housing) / k_total      # eq. 1, no friction power
+    theta = steady + (theta_clutch_degC - steady) * np.exp(-k_total * n * dt / cal.heat_capacity)
+    return float(theta), t0_s + n * dt
 
 
 def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None = None, tcu=None,
@@ -136,6 +170,8 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
         t0 = 0.0
         records = []
         for i in range(scenario.shifts):
+            if i > 0:
+                theta, t0 = _between_shifts(params, tcu, enc, scenario, theta, t0)
             rec = _one_shift(params, tcu, enc, db, scenario, theta, t0, params.seed + i, target_s, shift_cal)
             records.append(rec)
             theta = rec["end_theta_degC"]
@@ -146,18 +182,19 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
             tcu.close()
 
 
-def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float) -> dict:
+def reference_run(rec: dict, shift_cal, clutch_cal, theta_start_degC: float, reference=None) -> dict:
     """The double-precision reference (reference/shift.py) on the inputs the TCU received in rec, with the
     TCU's safe state from its VfsCommand: per step the reference's current and the TCU's (decoded), and the
-    reports of both."""
+    reports of both. reference: a ShiftReference to go on with (the next shift of a run_case: the clutch
+    state and the learned values carried over, theta_start_degC unused); out["reference"] is the one used."""
     db = canlog.database()
     msgs = {n: db.get_message_by_name(n) for n in (canlog.SENSORS, canlog.SHIFT_COMMAND, canlog.COMMAND,
                                                    canlog.SHIFT_REPORT)}
     ids = {m.frame_id: n for n, m in msgs.items()}
-    ref = shift_reference.ShiftReference(shift_cal, clutch_cal, theta_start_degC)
+    ref = reference or shift_reference.ShiftReference(shift_cal, clutch_cal, theta_start_degC)
     n = len(rec["frames_in"])
     out = {"reference_mA": np.empty(n), "tcu_mA": np.empty(n), "reference_report": None, "tcu_report": None,
-           "reference_report_step": None, "tcu_report_step": None}
+           "reference_report_step": None, "tcu_report_step": None, "reference": ref}
     outputs = {}
     for k, fid, data in rec["frames"]:
         outputs.setdefault(k, []).append((fid, bytes.fromhex(data)))
