@@ -23,6 +23,7 @@ film_table   the h_bar(p_c) table a calibration gives the firmware: build, check
 loader       load: TOML, units, sources, rules, film table
 writer       render_calibration: a base file with values and sources replaced
 shift        the shift controller's calibration (its own file format and rules)
+adaptation_image  the adaptation image: one clutch's learned values (wc_adapt_image.h), read and written
 """
 from __future__ import annotations
 
