@@ -31,7 +31,12 @@
  * unique); no input-rejection bit for these valid inputs; current within the
  * calibration's range (never negative), the minimum for OPEN and the maximum
  * for LOCKED; force within [0, F_max]; the estimate within the envelope.
- * A rejected calibration must make wc_model_init fail with the same code. */
+ * A rejected calibration must make wc_model_init fail with the same code.
+ *
+ * Byte 0 with bit 7 set (FZ_ADAPT_IMAGE_INPUT): the input is an adaptation
+ * image instead, read and checked by fuzz_adapt_image.c (the persistent image
+ * format's loader, DESIGN 12: a fourth harness would add a minute to
+ * scripts/test.sh, see README.md). */
 #include <float.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -40,6 +45,7 @@
 
 #include <wetclutch/wetclutch.h>
 
+#include "fuzz_adapt_image.h"
 #include "wc_fuzz_common.h"
 #include "wc_table1_calibration.h"
 
@@ -57,8 +63,11 @@ static unsigned long accepted;  /* calibrations the check accepted, evaluated on
  * that reach the model); scripts/fuzz.sh prints the line. */
 static void report_acceptance(void)
 {
-    fprintf(stderr, "fuzz_calibration: %lu inputs, %lu accepted by wc_calibration_check and evaluated\n", inputs,
-            accepted);
+    unsigned long images;
+    unsigned long loaded;
+    fz_adapt_image_counts(&images, &loaded);
+    fprintf(stderr, "fuzz_calibration: %lu inputs, %lu accepted by wc_calibration_check and evaluated; "
+            "%lu adaptation images, %lu loaded\n", inputs, accepted, images, loaded);
 }
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
@@ -321,6 +330,10 @@ static void print_calibration(const wc_calibration_t *c)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    if ((size > 0u) && ((data[0] & FZ_ADAPT_IMAGE_INPUT) != 0u)) {
+        fz_adapt_image_input(data, size, verbose);
+        return 0;
+    }
     fz_reader_t r;
     fz_reader_init(&r, data, size);
     wc_calibration_t c = wc_table1_calibration;

@@ -12,6 +12,7 @@ alive counter in the low nibble of byte 1: src/can/wc_e2e.h).
 import math
 import pathlib
 import struct
+import zlib
 
 HERE = pathlib.Path(__file__).resolve().parent
 CORPUS = HERE / "corpus"
@@ -303,8 +304,40 @@ def calibration_seeds():
     }
 
 
+# --------------------------------------------------------------------------
+# adaptation images: fuzz_calibration with byte 0 bit 7 set (fuzz_adapt_image.c)
+# --------------------------------------------------------------------------
+
+def adapt_image(clutch_id, scales, confidences, film, kiss, shifts):
+    """The adaptation image (wc_adapt_image.h): magic "WCAP", version 1, 56-byte payload, CRC-32."""
+    payload = struct.pack("<I5f5fffI", clutch_id, *scales, *confidences, film, kiss, shifts)
+    body = struct.pack("<IIII", 0x50414357, 1, len(payload), 0) + payload
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+def f_in(fraction):
+    """tag 3: lo + (hi - lo) * fraction, inside the argument's range."""
+    return bytes([3]) + struct.pack("<H", round(fraction * 65535))
+
+
+def adapt_image_seeds():
+    learned = adapt_image(2, (1.05, 0.97, 1.0, 1.125, 0.9), (0.25, 0.5, 0.0, 1.0, 0.125), 1.5, -1234.5, 42)
+    fields = b"".join(f_in(0.5) + f_in(0.25) for _ in range(5))        # scales, confidences: in band
+    return {
+        "adapt_image_learned": bytes([0x80, 0]) + learned,                 # as is: loads
+        "adapt_image_defaults": bytes([0x80, 0]) + adapt_image(0, (1.0,) * 5, (0.0,) * 5, 1.0, 0.0, 0),
+        "adapt_image_payload": bytes([0x80, 1]) + learned[16:72],          # resealed payload bytes
+        "adapt_image_corrupt": bytes([0x80, 2]) + learned[16:72] + bytes([30, 0x10, 76]),  # a flipped bit
+        "adapt_image_values": bytes([0x80, 3, 0, 0, 0, 0]) + fields + f_in(0.5) + f_in(0.5) + bytes(4),
+        # the bands read too (scale band 0.4, film 0.5..2, kiss 1e5 Pa), then every value on a band edge
+        "adapt_image_bands": bytes([0x80, 0x0B]) + f_in(0.8) + f_in(0.5) + f_in(1 / 9) + f_in(0.1)
+        + bytes([0, 0, 0, 0]) + b"".join(bytes([7, 1, 7, 0]) for _ in range(6)) + bytes(4),
+    }
+
+
 def main():
-    for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration_seeds())):
+    calibration = {**calibration_seeds(), **adapt_image_seeds()}
+    for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration)):
         folder = CORPUS / name
         folder.mkdir(parents=True, exist_ok=True)
         for seed, data in sorted(seeds.items()):
