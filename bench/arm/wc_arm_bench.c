@@ -200,6 +200,7 @@ typedef struct {
     uint8_t crc;
     wc_shift_t *shift;
     const wc_shift_calibration_t *shift_cal;
+    wc_adapt_t *adapt;                       /* the shift rows: NULL (adaptation off) or the adaptive run's */
     wc_shift_command_t shift_command;
     wc_shift_report_t shift_report;
     bool shift_ended;

@@ -40,8 +40,12 @@
  *     carries the learned scale, so rho is the remaining error); node i's
  *     share q_i = W_i / sum W, W_i = sum over the samples of w_i(theta) T_model
  *     (w_i: the interpolation weight of node i at the sample's theta, so a
- *     node learns only from the temperatures near it). Then
- *         s_i += clip(adapt_scale_gain q_i s_i (rho - 1), +-adapt_scale_step),
+ *     node learns only from the temperatures near it). Then, normalised so
+ *     that the interpolated scale at the window's temperatures moves by the
+ *     gain times its error (Q = sum_j q_j^2 > 0):
+ *         s_i += clip(adapt_scale_gain g_i s_i (rho - 1), +-adapt_scale_step),
+ *         g_i = max(q_i / Q, 1 - c_i)   (c_i the confidence before the update: a
+ *     node not yet learned follows the measurement in full, a smooth prior),
  *     clipped to [1 - adapt_scale_band, 1 + adapt_scale_band];
  *         c_i += adapt_confidence_gain q_i (1 - c_i)   (confidence, 0..1).
  *   - kiss point: least squares of the residual r = T_imp - T_model on

@@ -188,14 +188,25 @@ wc_adapt_change_t wc_adapt_finish(wc_adapt_t *adapt, const wc_shift_calibration_
         /* friction scale per node, by its share of the window (DESIGN 12) */
         float total_Nm = 0.0f;
         for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) { total_Nm += w->weight_Nm[i]; }
+        float share[WC_ADAPT_NODES];
+        float share_sq = 0.0f;  /* sum of the squared shares, in [1/WC_ADAPT_NODES, 1] */
+        for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
+            share[i] = (total_Nm > 0.0f) ? clip(w->weight_Nm[i] / total_Nm, 0.0f, 1.0f) : 0.0f;
+            share_sq += share[i] * share[i];
+        }
         const float band = cal->adapt_scale_band;
         for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
-            const float share = (total_Nm > 0.0f) ? clip(w->weight_Nm[i] / total_Nm, 0.0f, 1.0f) : 0.0f;
+            /* normalised: the interpolated scale at the window's temperatures moves by gain * its error;
+             * a node not yet learned (confidence 0) follows the measurement in full (a smooth prior:
+             * neighbouring temperatures have similar scales until shifts there say otherwise) */
             const float s = v->friction_scale[i];
-            const float step = clip(cal->adapt_scale_gain * share * s * (rho - 1.0f), -cal->adapt_scale_step,
+            const float own = (share_sq > 0.0f) ? (share[i] / share_sq) : 0.0f;
+            const float unlearned = 1.0f - v->confidence[i];
+            const float weight = (own > unlearned) ? own : unlearned;
+            const float step = clip(cal->adapt_scale_gain * weight * s * (rho - 1.0f), -cal->adapt_scale_step,
                                     cal->adapt_scale_step);
             v->friction_scale[i] = clip(s + step, 1.0f - band, 1.0f + band);
-            v->confidence[i] = clip(v->confidence[i] + cal->adapt_confidence_gain * share * (1.0f - v->confidence[i]),
+            v->confidence[i] = clip(v->confidence[i] + cal->adapt_confidence_gain * share[i] * (1.0f - v->confidence[i]),
                                     0.0f, 1.0f);
         }
         /* kiss point: the force offset the residual shows */
