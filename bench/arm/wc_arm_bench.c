@@ -125,12 +125,16 @@ typedef enum {
     ROW_LOOP_STEP_SHIFT,
     ROW_SHIFT_STEP_FILM,
     ROW_LOOP_STEP_SHIFT_FILM,
+    ROW_SHIFT_STEP_ADAPT,
+    ROW_SHIFT_END_ADAPT,
     ROWS
 } row_t;
 
 /* Names as in bench/arm_ceilings.txt (no spaces). */
 static const char *const row_name[ROWS] = {
     [ROW_CLUTCH_STEP] = "wc_clutch_step",
+    [ROW_SHIFT_STEP_ADAPT] = "wc_shift_step:inertia_adaptive",
+    [ROW_SHIFT_END_ADAPT] = "wc_shift_step:end_adaptive",
     [ROW_CLUTCH_STEP_FILM] = "wc_clutch_step:film",
     [ROW_CLUTCH_STEP_FILM_LAG] = "wc_clutch_step:film_lag",
     [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
@@ -575,11 +579,18 @@ static void plant_advance(shift_plant_t *p, uint32_t phase, const wc_step_output
 }
 
 static wc_shift_t shift;
+static wc_adapt_t adapt;
+static wc_shift_calibration_t shift_adaptive;  /* shift_calibration with adaptation on (DESIGN 12) */
 
-/* wc_shift_step on its own: every step that starts in the inertia phase. */
-static void bench_shift_step(const wc_calibration_t *cal, row_t row)
+/* wc_shift_step on its own: every step that starts in the inertia phase;
+ * adaptive: with adaptation on (its samples), and end_row the step in which
+ * the shift ends (the adaptation's update, wc_adapt_finish). */
+static void bench_shift_step(const wc_calibration_t *cal, row_t row, bool adaptive, row_t end_row)
 {
-    if ((wc_shift_calibration_check(&shift_calibration) != WC_SHIFT_CAL_OK) ||
+    shift_adaptive = shift_calibration;
+    shift_adaptive.adaptation = 1u;
+    wc_adapt_reset(&adapt);
+    if ((wc_shift_calibration_check(&shift_adaptive) != WC_SHIFT_CAL_OK) ||
         (wc_clutch_init(&clutch, cal, SHIFT_OIL_degC) != WC_CAL_OK)) {
         fail("shift: calibration");
         return;
@@ -588,7 +599,8 @@ static void bench_shift_step(const wc_calibration_t *cal, row_t row)
     shift_plant_t plant = {SHIFT_START_SLIP_rad_s, false};
     ctx.clutch = &clutch;
     ctx.shift = &shift;
-    ctx.shift_cal = &shift_calibration;
+    ctx.shift_cal = adaptive ? &shift_adaptive : &shift_calibration;
+    ctx.adapt = adaptive ? &adapt : NULL;
     ctx.shift_command = (wc_shift_command_t){true, 2u, SHIFT_TURBINE_TORQUE_Nm, SHIFT_TARGET_TIME_s};
     static const wc_step_output_t no_output;
     ctx.step_out = no_output;  /* wc_shift_step reads the previous step's status (anti-windup) */
@@ -598,13 +610,17 @@ static void bench_shift_step(const wc_calibration_t *cal, row_t row)
                                         .theta_housing_degC = SHIFT_OIL_degC};
         if (shift.phase == (uint32_t)WC_SHIFT_INERTIA) {
             record(row, measure(thunk_shift_step, &ctx));
+        } else if (adaptive && (shift.phase == (uint32_t)WC_SHIFT_LOCKUP)) {
+            const uint32_t n = measure(thunk_shift_step, &ctx);
+            if (ctx.shift_ended) { record(end_row, n); }
         } else {
             thunk_shift_step(&ctx);
         }
         if (ctx.shift_ended) { reports++; }
         plant_advance(&plant, shift.phase, &ctx.step_out);
     }
-    if ((reports != 1u) || (shift.phase != (uint32_t)WC_SHIFT_LOCKED) || (ctx.shift_report.abort_reason != 0u)) {
+    if ((reports != 1u) || (shift.phase != (uint32_t)WC_SHIFT_LOCKED) || (ctx.shift_report.abort_reason != 0u) ||
+        (adaptive && (ctx.shift_report.adaptation.result != (uint32_t)WC_ADAPT_RESULT_UPDATED))) {
         wc_arm_puts("SHIFT phase ");
         wc_arm_put_u32(shift.phase);
         wc_arm_puts(", abort reason ");
@@ -668,7 +684,7 @@ static void bench_loop_shift(const wc_calibration_t *cal, row_t row)
         } else {
             thunk_loop_step(&ctx);
         }
-        if (ctx.tx_frames == WC_LOOP_TX_FRAMES) { reports++; }
+        if (ctx.tx_frames > WC_LOOP_TX_CYCLIC) { reports++; }  /* ShiftReport (no AdaptationReport: adaptation off) */
         plant_advance(&plant, loop.shift.phase, &loop.last);
     }
     /* E2E: SyncCounter frames of each of the three inputs are not used */
@@ -750,9 +766,10 @@ int main(void)
             }
         }
 
-        bench_shift_step(wc_arm_calibration, ROW_SHIFT_STEP);
+        bench_shift_step(wc_arm_calibration, ROW_SHIFT_STEP, false, ROW_SHIFT_STEP);
         bench_loop_shift(wc_arm_calibration, ROW_LOOP_STEP_SHIFT);
-        bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_FILM);
+        bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_FILM, false, ROW_SHIFT_STEP_FILM);
+        bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_ADAPT, true, ROW_SHIFT_END_ADAPT);
         bench_loop_shift(wc_arm_identified_calibration, ROW_LOOP_STEP_SHIFT_FILM);
 
         wc_arm_puts("GRID ");

@@ -3,6 +3,7 @@
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "wc_film_internal.h"
 #include "wetclutch/wc_film.h"
@@ -108,6 +109,17 @@ static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, f
 /* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
 static bool nonzero(float x) { return (x < 0.0f) || (x > 0.0f); }
 
+/* Any field of the correction set (a bit pattern other than +0): one test on
+ * the plain step's path instead of the range checks. */
+static bool correction_present(const wc_model_correction_t *c)
+{
+    uint32_t scale, film, kiss;
+    memcpy(&scale, &c->friction_scale_delta, sizeof scale);
+    memcpy(&film, &c->film_factor_delta, sizeof film);
+    memcpy(&kiss, &c->kiss_offset_N, sizeof kiss);
+    return (scale | film | kiss) != 0u;
+}
+
 /* The adaptation's correction (DESIGN 12) if every field is in its range, else none. */
 static wc_model_correction_t accept_correction(const wc_model_correction_t *c)
 {
@@ -152,8 +164,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     wc_torque_point_t point;
     wc_torque_point(model, u->slip_rad_s, out->theta_degC, &point);
     float static_Nm_per_N = wc_static_capacity_Nm_per_N(model, &point);
-    const wc_model_correction_t correction = accept_correction(&in->correction);
-    if (nonzero(correction.friction_scale_delta)) {
+    const bool corrected = correction_present(&in->correction);  /* DESIGN 12; absent: the calibration's model */
+    wc_model_correction_t correction = { 0.0f, 0.0f, 0.0f };
+    if (corrected) { correction = accept_correction(&in->correction); }
+    if (corrected && nonzero(correction.friction_scale_delta)) {
         /* DESIGN 12: the learned friction scale corrects mu_f (eq. 18), kinetic and static */
         const float scale = 1.0f + correction.friction_scale_delta;
         point.mu_f *= scale;
@@ -174,14 +188,15 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         inv.pressure_Pa = cal->vfs_gain_Pa_per_mA * inv.current_mA;
         inv.iterations = 0u;
     }
-    if ((in->mode == WC_MODE_TORQUE) && nonzero(correction.kiss_offset_N)) {
+    if (corrected && (in->mode == WC_MODE_TORQUE) && nonzero(correction.kiss_offset_N)) {
         status |= shift_kiss(model->cal, correction.kiss_offset_N, &inv);
     }
     /* DESIGN 9: the asperity contact of the film state, once per period: the
      * lead, the torque and the film's advance share it. */
     const bool film = model->film_damping_m4 > 0.0f;
     /* the squeeze film's damping at this viscosity, times the learned film factor (DESIGN 9, 12) */
-    const float damping_N_s_m2 = model->film_damping_m4 * (1.0f + correction.film_factor_delta) * point.viscosity_Pa_s;
+    float damping_N_s_m2 = model->film_damping_m4 * point.viscosity_Pa_s;
+    if (corrected) { damping_N_s_m2 *= 1.0f + correction.film_factor_delta; }
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
@@ -201,7 +216,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
-    if (nonzero(correction.kiss_offset_N)) {
+    if (corrected && nonzero(correction.kiss_offset_N)) {
         /* DESIGN 12: the learned kiss point; within [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
         const float moved_N = force_N - correction.kiss_offset_N;
         force_N = (moved_N > 0.0f) ? ((moved_N < WC_FORCE_MAX_N) ? moved_N : WC_FORCE_MAX_N) : 0.0f;
