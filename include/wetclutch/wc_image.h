@@ -41,7 +41,8 @@
 #define WC_IMAGE_PAYLOAD_MAX_BYTES 16384u
 #endif
 
-/* What wc_image_read found, in the order it checks. */
+/* What wc_image_read found, in the order it checks (tools/wetclutch/util/image.py
+ * uses the same codes and names). */
 typedef enum {
     WC_IMAGE_OK = 0,
     WC_IMAGE_MISSING = 1,       /* no image: NULL or length 0 (an erased or never written store) */
@@ -61,7 +62,8 @@ uint32_t wc_image_crc32(const uint8_t *data, size_t length);
  * payload, CRC. Returns the bytes written, WC_IMAGE_BYTES(payload_length);
  * 0 (nothing written) when image is NULL, capacity is too small, the payload
  * is longer than WC_IMAGE_PAYLOAD_MAX_BYTES or NULL with a nonzero length.
- * payload may lie inside image (it is moved, not copied). */
+ * payload must not overlap image, unless it is already in place at
+ * image + WC_IMAGE_HEADER_BYTES (then it is left as it is: wc_image_seal). */
 size_t wc_image_write(uint8_t *image, size_t capacity, uint32_t magic, uint32_t version, const uint8_t *payload,
                       uint32_t payload_length);
 
@@ -78,10 +80,6 @@ size_t wc_image_seal(uint8_t *image, size_t capacity, uint32_t magic, uint32_t v
  * NULL. payload may be NULL (status only). Never reads past image[length - 1]. */
 wc_image_status_t wc_image_read(const uint8_t *image, size_t length, uint32_t magic, uint32_t version,
                                 uint32_t payload_length, const uint8_t **payload);
-
-/* The status's name ("OK", "BAD_CRC", ...; "UNKNOWN" outside the enum), as
- * tools/wetclutch/util/image.py names it. */
-const char *wc_image_status_name(wc_image_status_t status);
 
 /* Little-endian fields, byte by byte: 4 bytes at dst / from src. A float
  * travels as its IEEE-754 bit pattern (NaN payloads and -0 kept). */

@@ -53,19 +53,17 @@ uint32_t wc_adapt_image_load(wc_adapt_t *adapt, const struct wc_shift_calibratio
         if (wc_image_get_u32(&payload[ADAPT_OFFSET_CLUTCH_ID]) != clutch_id) {
             result = WC_ADAPT_IMAGE_WRONG_CLUTCH;
         } else {
-            wc_adapt_values_t v;
+            /* decoded in place: a refused image's values are replaced by the defaults below, before
+             * anyone sees them (the caller owns adapt, wc_adapt_image.h), and no 56-byte copy on the stack */
+            wc_adapt_values_t *v = &adapt->values;
             for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
-                v.friction_scale[i] = wc_image_get_f32(&payload[ADAPT_OFFSET_SCALE + (4u * i)]);
-                v.confidence[i] = wc_image_get_f32(&payload[ADAPT_OFFSET_CONFIDENCE + (4u * i)]);
+                v->friction_scale[i] = wc_image_get_f32(&payload[ADAPT_OFFSET_SCALE + (4u * i)]);
+                v->confidence[i] = wc_image_get_f32(&payload[ADAPT_OFFSET_CONFIDENCE + (4u * i)]);
             }
-            v.film_factor = wc_image_get_f32(&payload[ADAPT_OFFSET_FILM_FACTOR]);
-            v.kiss_offset_Pa = wc_image_get_f32(&payload[ADAPT_OFFSET_KISS_OFFSET]);
-            v.shifts_learned = wc_image_get_u32(&payload[ADAPT_OFFSET_SHIFTS_LEARNED]);
-            if ((cal != NULL) && wc_adapt_values_valid(&v, cal)) {
-                adapt->values = v;
-            } else {
-                result = WC_ADAPT_IMAGE_BAD_VALUES;
-            }
+            v->film_factor = wc_image_get_f32(&payload[ADAPT_OFFSET_FILM_FACTOR]);
+            v->kiss_offset_Pa = wc_image_get_f32(&payload[ADAPT_OFFSET_KISS_OFFSET]);
+            v->shifts_learned = wc_image_get_u32(&payload[ADAPT_OFFSET_SHIFTS_LEARNED]);
+            if ((cal == NULL) || !wc_adapt_values_valid(v, cal)) { result = WC_ADAPT_IMAGE_BAD_VALUES; }
         }
     }
     adapt->status &= ~(WC_ADAPT_STATUS_IMAGE_MISSING | WC_ADAPT_STATUS_IMAGE_INVALID);

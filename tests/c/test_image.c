@@ -114,15 +114,15 @@ static void test_round_trip_and_layout(void **state)
     assert_int_equal(wc_image_read(image, sizeof image, MAGIC, 1u, PAYLOAD_BYTES, &payload), WC_IMAGE_OK);
     assert_int_equal(wc_image_read(image, IMAGE_BYTES, MAGIC, 1u, PAYLOAD_BYTES, NULL), WC_IMAGE_OK);
 
-    /* sealed in place: the same bytes; a payload inside the buffer is moved */
+    /* sealed in place, or written with the payload already in place: the same bytes */
     uint8_t sealed[IMAGE_BYTES];
     for (unsigned i = 0u; i < PAYLOAD_BYTES; ++i) { sealed[16u + i] = (uint8_t)i; }
     assert_int_equal(wc_image_seal(sealed, sizeof sealed, MAGIC, 1u, PAYLOAD_BYTES), IMAGE_BYTES);
     assert_memory_equal(sealed, image, IMAGE_BYTES);
-    uint8_t moved[IMAGE_BYTES];
-    for (unsigned i = 0u; i < PAYLOAD_BYTES; ++i) { moved[i] = (uint8_t)i; }
-    assert_int_equal(wc_image_write(moved, sizeof moved, MAGIC, 1u, moved, PAYLOAD_BYTES), IMAGE_BYTES);
-    assert_memory_equal(moved, image, IMAGE_BYTES);
+    uint8_t in_place[IMAGE_BYTES];
+    for (unsigned i = 0u; i < PAYLOAD_BYTES; ++i) { in_place[16u + i] = (uint8_t)i; }
+    assert_int_equal(wc_image_write(in_place, sizeof in_place, MAGIC, 1u, &in_place[16], PAYLOAD_BYTES), IMAGE_BYTES);
+    assert_memory_equal(in_place, image, IMAGE_BYTES);
 
     /* an empty payload */
     uint8_t empty[WC_IMAGE_BYTES(0u)];
@@ -161,7 +161,7 @@ static void test_every_single_bit_flip_is_detected(void **state)
         image[bit / 8u] ^= (uint8_t)(1u << (bit % 8u));
         const uint8_t *payload = good;
         const wc_image_status_t status = wc_image_read(image, sizeof image, MAGIC, 1u, PAYLOAD_BYTES, &payload);
-        WC_CHECK(status == status_of_flip(bit), "bit %zu: %s", bit, wc_image_status_name(status));
+        WC_CHECK(status == status_of_flip(bit), "bit %zu: status %d", bit, (int)status);
         assert_null(payload);
     }
 }
@@ -178,8 +178,8 @@ static void test_every_truncation_is_detected(void **state)
         memcpy(image, good, n);
         const uint8_t *payload = good;
         const wc_image_status_t status = wc_image_read(image, n, MAGIC, 1u, PAYLOAD_BYTES, &payload);
-        WC_CHECK(status == ((n == 0u) ? WC_IMAGE_MISSING : WC_IMAGE_TRUNCATED), "length %zu: %s", n,
-                 wc_image_status_name(status));
+        WC_CHECK(status == ((n == 0u) ? WC_IMAGE_MISSING : WC_IMAGE_TRUNCATED), "length %zu: status %d", n,
+                 (int)status);
         assert_null(payload);
         free(image);
     }
@@ -205,21 +205,13 @@ static void test_a_wrong_field_with_a_right_crc_is_named(void **state)
         wc_image_put_u32(&image[cases[i].offset], cases[i].value);
         reseal(image);
         const wc_image_status_t status = wc_image_read(image, sizeof image, MAGIC, 1u, PAYLOAD_BYTES, NULL);
-        WC_CHECK(status == cases[i].expected, "case %zu: %s", i, wc_image_status_name(status));
+        WC_CHECK(status == cases[i].expected, "case %zu: status %d", i, (int)status);
     }
     /* a caller that expects the largest u32 length: BAD_LENGTH (over the format's limit), no overflow */
     uint8_t header[WC_IMAGE_BYTES(0u)];
     assert_int_equal(wc_image_write(header, sizeof header, MAGIC, 1u, NULL, 0u), sizeof header);
     wc_image_put_u32(&header[8], 0xFFFFFFFFu);
     assert_int_equal(wc_image_read(header, sizeof header, MAGIC, 1u, 0xFFFFFFFFu, NULL), WC_IMAGE_BAD_LENGTH);
-}
-
-static void test_status_names(void **state)
-{
-    (void)state;
-    assert_string_equal(wc_image_status_name(WC_IMAGE_OK), "OK");
-    assert_string_equal(wc_image_status_name(WC_IMAGE_BAD_CRC), "BAD_CRC");
-    assert_string_equal(wc_image_status_name(WC_IMAGE_STATUSES), "UNKNOWN");
 }
 
 /* ---- the adaptation image ---------------------------------------------------- */
@@ -447,7 +439,6 @@ int main(void)
         cmocka_unit_test(test_every_single_bit_flip_is_detected),
         cmocka_unit_test(test_every_truncation_is_detected),
         cmocka_unit_test(test_a_wrong_field_with_a_right_crc_is_named),
-        cmocka_unit_test(test_status_names),
         cmocka_unit_test(test_c_writer_gives_the_golden_bytes),
         cmocka_unit_test(test_load_round_trip),
         cmocka_unit_test(test_load_missing_wrong_clutch_and_version),
