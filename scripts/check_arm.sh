@@ -267,6 +267,10 @@ def worst(title, stack=()):
         if name in names and names[name] != title:
             return worst(names[name], stack)
         own, calls, estimated = ext_frame.get(name, 0), ext_calls.get(name, ()), True
+        if name == "__indirect_call":
+            # the only call through a pointer: the loop's adaptation hook (wc_loop_config_t.adaptation_changed,
+            # DESIGN 12), the integrator's function: its own stack is the integrator's, added to this chain
+            return (0, ("integrator's adaptation hook",), True)
         if name not in ext_frame:
             raise SystemExit(f"{name}: not found in the linked image")
     best = (0, (), False)

@@ -245,7 +245,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
 /* Before the clutch step: the transitions on the command and the loop's
  * state, then the clutch input (in place: mode, request, carried torque, lag
  * compensation, temperature source). saturated: the last step's output was. */
-static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                          bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
                          wc_adapt_t *adapt, wc_step_input_t *in)
 {
@@ -304,7 +304,7 @@ static void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, c
 
 /* After the clutch step: the lock-up decides the inertia phase's end, the
  * quality vector, the report. Returns true when the shift ended. */
-static bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
+static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
                         wc_adapt_t *adapt, const wc_step_output_t *out, wc_shift_report_t *report,
                         uint32_t phase_before, float slip_rad_s, float dt_s)
 {

@@ -248,6 +248,109 @@ static void test_loop_mode3_without_shift(void **state)
     assert_int_equal(l.reports, 0u);
 }
 
+/* ======================================================================== */
+/* Adaptation in the loop (DESIGN 12): AdaptationReport, the hook, the reset */
+/* ======================================================================== */
+
+typedef struct {
+    uint32_t calls;
+    wc_adapt_values_t values;  /* as the hook saw them */
+} hook_log_t;
+
+static void adaptation_hook(const wc_adapt_t *adapt, void *context)
+{
+    hook_log_t *log = context;
+    log->calls++;
+    log->values = adapt->values;
+}
+
+/* One period of the adaptive loop on a plant whose clutch gives friction_factor
+ * times the model's torque; reset: ShiftCommand.AdaptationReset. Returns the
+ * frames sent; *adaptation the decoded AdaptationReport when there was one. */
+static uint32_t adaptive_period(loop_sim_t *l, int shift_request, bool reset, float friction_factor,
+                                wc_can_adaptation_report_phys_t *adaptation, bool *had_adaptation)
+{
+    loop_queue_sensors(l);
+    loop_queue_request(l, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE);
+    wc_can_frame_t f = wc_test_can_frame(WC_CAN_SHIFT_COMMAND_FRAME_ID);
+    const wc_can_shift_command_phys_t c = { shift_request ? 1.0f : 0.0f, reset ? 1.0f : 0.0f, 2.0f, TURBINE_TORQUE_Nm,
+                                            1000.0f * TARGET_TIME_s, l->alive };
+    assert_int_equal(wc_can_encode_shift_command(f.data, &c, sizeof f.data), WC_CAN_OK);
+    assert_true(wc_loop_receive(&l->loop, &f));
+    l->alive = wc_e2e_counter_next(l->alive);
+    l->n = wc_loop_step(&l->loop, l->out);
+    *had_adaptation = false;
+    for (uint32_t i = WC_LOOP_TX_CYCLIC; i < l->n; ++i) {
+        if (l->out[i].id == WC_CAN_ADAPTATION_REPORT_FRAME_ID) {
+            assert_true(wc_can_decode_adaptation_report(adaptation, l->out[i].data, l->out[i].dlc) <= WC_CAN_SATURATED);
+            *had_adaptation = true;
+        }
+    }
+    if (l->loop.shift.phase == (uint32_t)WC_SHIFT_INERTIA) { l->offgoing_released = true; }
+    if (l->offgoing_released) {
+        wc_step_output_t plant = l->loop.last;
+        plant.model.torque_Nm *= friction_factor;  /* the real clutch: more friction than the model */
+        l->slip_rad_s = wc_test_shift_plant_slip_rad_s(&test_cal, l->slip_rad_s, TURBINE_TORQUE_Nm, &plant, DT_s);
+    }
+    return l->n;
+}
+
+static void test_loop_adaptation_report_hook_and_reset(void **state)
+{
+    (void)state;
+    static loop_sim_t l;
+    static wc_shift_calibration_t adaptive;
+    adaptive = test_cal;
+    adaptive.adaptation = 1u;
+    loop_start(&l, &adaptive);
+    static hook_log_t log;
+    memset(&log, 0, sizeof log);
+    l.loop.config.adaptation_changed = adaptation_hook;
+    l.loop.config.adaptation_context = &log;
+    assert_int_equal(wc_loop_load_adaptation(&l.loop, NULL, 0u), WC_IMAGE_MISSING);
+    wc_can_adaptation_report_phys_t a;
+    bool had = false;
+    uint32_t reports = 0u;
+    for (int k = 0; (k < 2000) && (reports == 0u); ++k) {
+        /* AdaptationReset rises during the shift (k 200: running): ignored, no reset */
+        const uint32_t n = adaptive_period(&l, 1, k >= 200, 1.2f, &a, &had);
+        if (had) {
+            reports++;
+            assert_int_equal(n, WC_LOOP_TX_FRAMES);  /* VfsCommand, ClutchEstimate, ShiftReport, AdaptationReport */
+            assert_int_equal(l.out[2].id, WC_CAN_SHIFT_REPORT_FRAME_ID);
+        }
+    }
+    assert_int_equal(reports, 1u);
+    assert_int_equal(l.loop.report.abort_reason, WC_SHIFT_ABORT_NONE);
+    /* a clutch 20 % stronger than the model: the scale rises, by at most the per-shift step */
+    const wc_adapt_change_t *change = &l.loop.report.adaptation;
+    assert_int_equal(change->result, WC_ADAPT_RESULT_UPDATED);
+    WC_CHECK((change->friction_scale_change > 0.0f) && (change->friction_scale_change <= adaptive.adapt_scale_step),
+             "scale change %g (step %g)", (double)change->friction_scale_change, (double)adaptive.adapt_scale_step);
+    assert_float_equal(a.result, 1.0f, 0.0f);
+    assert_float_equal(a.image_missing, 1.0f, 0.0f);
+    assert_float_equal(a.friction_scale, change->friction_scale, 0.00025f);       /* one raw step (DBC) */
+    assert_float_equal(a.friction_scale_change, change->friction_scale_change, 0.00025f);
+    assert_int_equal(log.calls, 1u);
+    assert_memory_equal(&log.values, &l.loop.adapt.values, sizeof log.values);
+    print_message("    adaptation: node %u scale %.4f (+%.4f), confidence %.2f\n", (unsigned)change->node,
+                  (double)change->friction_scale, (double)change->friction_scale_change, (double)change->confidence);
+    /* the reset's edge came during the shift: nothing reset */
+    assert_true(l.loop.adapt.values.friction_scale[change->node] > 1.0f);
+    /* the request withdrawn, the reset bit dropped, then raised: a reset, reported and stored */
+    for (int k = 0; k < 5; ++k) { (void)adaptive_period(&l, 0, false, 1.2f, &a, &had); assert_false(had); }
+    (void)adaptive_period(&l, 0, true, 1.2f, &a, &had);
+    assert_true(had);
+    assert_float_equal(a.result, 0.0f, 0.0f);
+    assert_float_equal(a.friction_scale, 1.0f, 0.0f);
+    assert_int_equal(log.calls, 2u);
+    for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) { assert_float_equal(log.values.friction_scale[i], 1.0f, 0.0f); }
+    assert_true((l.loop.adapt.status & WC_ADAPT_STATUS_RESET) != 0u);
+    (void)adaptive_period(&l, 0, true, 1.2f, &a, &had);  /* held: no second reset */
+    assert_false(had);
+    assert_int_equal(log.calls, 2u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -256,6 +359,7 @@ int main(void)
         cmocka_unit_test(test_loop_safe_state_after_shift_releases),
         cmocka_unit_test(test_loop_leaving_shift_mode_after_the_shift_has_no_dip),
         cmocka_unit_test(test_loop_mode3_without_shift),
+        cmocka_unit_test(test_loop_adaptation_report_hook_and_reset),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
