@@ -735,9 +735,9 @@ struct wc_can_adaptation_report_t {
     /**
      * Learned friction scale (multiplies mu_f) of Node after the shift.
      *
-     * Range: 0..4000 (0.5..1.5 -)
-     * Scale: 0.00025
-     * Offset: 0.5
+     * Range: 0..4000 (0..2 -)
+     * Scale: 0.0005
+     * Offset: 0
      */
     uint16_t friction_scale;
 

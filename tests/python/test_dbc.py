@@ -37,6 +37,7 @@ FRAMES = {
     "VfsCommand": (0x120, "TCU", {"BENCH"}, 1, True),
     "ClutchEstimate": (0x121, "TCU", {"BENCH"}, 1, False),
     "ShiftReport": (0x122, "TCU", {"VCU"}, None, False),   # sent once per shift, not cyclic
+    "AdaptationReport": (0x123, "TCU", {"VCU"}, None, False),   # with ShiftReport when adaptation is on (DESIGN 12)
     "BenchMeasurement": (0x130, "BENCH", {"TCU"}, 1, False),
 }
 # Layout constants of src/can/wc_e2e.h.
@@ -213,10 +214,15 @@ static const struct { const char *name; const wc_can_signal_t *sig; } sigs[] = {
     SIG(clutch_estimate, mu_f), SIG(clutch_estimate, film_thickness),
     SIG(bench_measurement, load_cell_force), SIG(bench_measurement, measured_torque),
     SIG(bench_measurement, clutch_thermistor_temp),
-    SIG(shift_command, shift_request), SIG(shift_command, target_gear), SIG(shift_command, turbine_torque),
+    SIG(shift_command, shift_request), SIG(shift_command, adaptation_reset), SIG(shift_command, target_gear),
+    SIG(shift_command, turbine_torque),
     SIG(shift_command, target_inertia_time), SIG(shift_report, inertia_phase_time), SIG(shift_report, slip_rmse),
     SIG(shift_report, peak_jerk), SIG(shift_report, friction_energy), SIG(shift_report, peak_clutch_temp),
     SIG(shift_report, flare), SIG(shift_report, tie_up),
+    SIG(adaptation_report, result), SIG(adaptation_report, node), SIG(adaptation_report, image_missing),
+    SIG(adaptation_report, image_invalid), SIG(adaptation_report, friction_scale),
+    SIG(adaptation_report, friction_scale_change), SIG(adaptation_report, confidence),
+    SIG(adaptation_report, film_factor), SIG(adaptation_report, kiss_offset),
 };
 
 static float F(const char *s) { return strtof(s, NULL); }

@@ -1104,7 +1104,7 @@ bool wc_can_adaptation_report_friction_scale_is_in_range(uint16_t value)
 
 bool wc_can_adaptation_report_friction_scale_is_in_phys_range(float value)
 {
-    return ((value >= 0.5f) && (value <= 1.5f));
+    return ((value >= 0.0f) && (value <= 2.0f));
 }
 
 bool wc_can_adaptation_report_friction_scale_change_is_in_range(int16_t value)

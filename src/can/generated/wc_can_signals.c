@@ -111,7 +111,7 @@ const wc_can_signal_t wc_can_sig_adaptation_report_image_invalid = {
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
 const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale = {
-    .scale = 0.00025f, .offset = 0.5f, .raw_min = 0, .raw_max = 4000,
+    .scale = 0.0005f, .offset = 0.0f, .raw_min = 0, .raw_max = 4000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
 const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale_change = {
