@@ -9,6 +9,7 @@ import numpy as np
 from ..calibration import Calibration
 from ..reference import evaluate as reference, model
 from ..util import atomic
+from . import adapt_vectors
 from .lut import banner
 
 SLIP_RPM = (-750.0, 0.0, 0.5, 3.0, 12.0, 50.0, 100.0, 300.0, 750.0, 1500.0, 3000.0)
@@ -136,6 +137,7 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
         + _table("wc_golden_edges", "wc_golden_edges_t", edges,
                  ("step", "slip_rpm", "torque_request_Nm", "current_mA", "torque_Nm", "hbar_um", "contact_force_N",
                   "static_capacity_Nm", "status"))
+        + adapt_vectors.header_part(cal)
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )
     out_dir.mkdir(parents=True, exist_ok=True)

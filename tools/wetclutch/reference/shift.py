@@ -3,12 +3,16 @@ firmware's closed-loop frames are checked against (tests/python/test_shift.py).
 
 ShiftReference.step takes what the frame loop hands wc_shift_step (the decoded ShiftCommand, the loop's safe
 state, the sensor values) and steps its own ClutchReference (reference/model), as the firmware steps its clutch.
+With the shift calibration's adaptation on, its AdaptationReference (reference/adaptation.py) corrects the
+clutch model before each step of a running or locked shift, samples the inertia phase and learns at the
+shift's end; the learned values carry over to the reference's next shift (ShiftReference.adapt).
 """
 from __future__ import annotations
 
 import math
 
 from . import model
+from .adaptation import AdaptationReference, AdaptSettings, AdaptValues, f32
 
 IDLE, PREPARE, TORQUE, INERTIA, LOCKUP, LOCKED, ABORTED = range(7)
 RUNNING = (PREPARE, TORQUE, INERTIA, LOCKUP)
@@ -34,11 +38,14 @@ def feedforward_Nm(v: dict, turbine_torque_Nm: float, rate_rad_s2: float) -> flo
 
 
 class ShiftReference:
-    def __init__(self, shift_cal, clutch_cal, theta_start_degC: float):
+    def __init__(self, shift_cal, clutch_cal, theta_start_degC: float, adapt_values: AdaptValues | None = None):
         self.v = shift_cal.values
         self.cal = clutch_cal
         self.dt = clutch_cal.period
         self.clutch = model.ClutchReference(clutch_cal, theta_start_degC)
+        # the learned values (the calibration's, or adapt_values: an image read at init)
+        self.adapt = AdaptationReference(AdaptSettings.from_values(self.v), self.dt, clutch_cal.piston_area,
+                                         clutch_cal.film_squeeze_factor > 0.0, adapt_values)
         self.last_request = False
         self.last_status = 0
         self._reset()
@@ -51,7 +58,7 @@ class ShiftReference:
         self.inertia_periods = self.band_periods = 0
         self.report = {"inertia_time_s": 0.0, "slip_rmse_rad_s": 0.0, "peak_jerk_m_s3": 0.0,
                        "friction_energy_J": 0.0, "peak_theta_degC": 0.0, "flare": False, "tie_up": False,
-                       "abort_reason": ABORT_NONE}
+                       "abort_reason": ABORT_NONE, "adaptation": None}
 
     def _periods(self, time_s: float) -> int:
         return int(time_s / self.dt + 0.5)
@@ -123,13 +130,18 @@ class ShiftReference:
             if valid:
                 self.turbine_torque, self.target_s, self.start_slip = turbine_torque_Nm, target_inertia_s, slip
                 self.report["peak_theta_degC"] = model.THETA_MIN_DEGC
+                self.adapt.begin()
                 self._enter(PREPARE)
             else:
                 self._abort(ABORT_INVALID_COMMAND)
         if self.phase in RUNNING and 0.0 <= turbine_torque_Nm <= model.TORQUE_MAX_NM:
             self.turbine_torque = turbine_torque_Nm
-        mode, req, carried = model.MODE_OPEN, 0.0, 0.0
+        mode, req, carried, correction = model.MODE_OPEN, 0.0, 0.0, None
+        theta_from_oil = v["theta_source"] == THETA_SOURCE_OIL
         if self.phase in RUNNING or self.phase == LOCKED:
+            # DESIGN 12: the learned values at the temperature the model uses (before the phase's law: also
+            # in a step whose law aborts the shift)
+            correction = self.adapt.correction(oil_degC if theta_from_oil else self.clutch.theta)
             r = min(max(self._phase_request(slip, saturated), 0.0), model.TORQUE_MAX_NM)
             if self.phase != ABORTED:
                 mode, req = model.MODE_TORQUE, r
@@ -137,10 +149,14 @@ class ShiftReference:
                 carried = feedforward_Nm(v, self.turbine_torque, 0.0)
         out = self.clutch.step(slip_rpm, oil_degC, housing_degC, req, mode,
                                lag_compensation_time_s=v["lag_compensation_time"],
-                               theta_from_oil=v["theta_source"] == THETA_SOURCE_OIL, carried_torque_Nm=carried)
+                               theta_from_oil=theta_from_oil, carried_torque_Nm=carried, correction=correction)
         self.last_status = out["status"]
         phase_stepped = self.phase
         locked = bool(out["status"] & model.STATUS_LOCKED)
+        if self.phase == INERTIA:   # the adaptation's sample of this period (the phase's time before its count)
+            a, i_t = v["turbine_ratio"], v["turbine_inertia"]
+            self.adapt.sample(f32(f32(self.periods) * f32(self.dt)), slip, a * self.turbine_torque / i_t,
+                              a * a / i_t + v["output_ratio"] ** 2 / v["output_inertia"], out)
         if self.phase == INERTIA:
             elapsed = (self.periods + 1) * self.dt
             self.band_periods = self.band_periods + 1 if abs(slip) < self.cal.lock_slip else 0
@@ -174,5 +190,6 @@ class ShiftReference:
         if phase_before != self.phase and self.phase in (LOCKED, ABORTED):
             self.report["slip_rmse_rad_s"] = (math.sqrt(self.err_sq / self.inertia_periods)
                                               if self.inertia_periods else 0.0)
+            self.report["adaptation"] = self.adapt.finish(self.report["abort_reason"])
             return out, dict(self.report)
         return out, None

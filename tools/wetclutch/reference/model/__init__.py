@@ -16,6 +16,7 @@ inverse       torque request -> force -> pressure -> current (slipping and locke
 thermal       eq. 1: decay, steady state, the observer over a series
 lockup        the lock-up state machine (wc_lockup.c)
 clutch        the clutch step (wc_clutch_step): ClutchReference, clutch_steps
+correction    the adaptation's correction of the model (wc_model_correction_t, DESIGN 12)
 """
 from __future__ import annotations
 

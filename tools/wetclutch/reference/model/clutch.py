@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .correction import NONE, Correction, effective
 from .constants import (MODE_LOCKED, MODE_TORQUE, RAD_S_PER_RPM, STATUS_CURRENT_CLAMPED, STATUS_LOCKED,
                         STATUS_OVER_TEMPERATURE, THETA_MAX_DEGC, THETA_MIN_DEGC, THETA_OVER_DEGC,
                         THETA_OVER_HYSTERESIS_K, TORQUE_MAX_NM)
@@ -38,6 +39,11 @@ class ClutchReference:
     (Lockup.torque_Nm), no heat and STATUS_LOCKED; observer advanced with |T dw| and kept in
     [THETA_MIN_DEGC, THETA_MAX_DEGC], STATUS_OVER_TEMPERATURE above THETA_OVER_DEGC until it falls
     THETA_OVER_HYSTERESIS_K below. theta_from_oil: the model takes the oil temperature (thermal-blind).
+    correction: the adaptation's (model/correction.py, DESIGN 12): mu_f scaled in the torque, the inverse and
+    the static capacity, the film's damping scaled in its advance and the film lead, the contact force the
+    apply force (itself at least 0, DESIGN 2) minus the kiss offset, at least 0, and the wanted contact force
+    commanded at the pressure of the apply force itself plus the offset (at least 0); None or out of range:
+    none.
     The inputs are taken as valid (the frame loop's reference, hil/replay.py, holds invalid ones)."""
 
     def __init__(self, cal: Calibration, theta_start_degC: float):
@@ -52,7 +58,8 @@ class ClutchReference:
         self.lockup = Lockup(cal)
         self.over = False
 
-    def _lead_film(self, theta: float, time_s: float, force_cmd: float, current: float) -> float:
+    def _lead_film(self, theta: float, time_s: float, force_cmd: float, current: float,
+                   corr: Correction = NONE) -> float:
         """DESIGN 9: the apply force that squeezes the film state towards the wanted force's film with time
         constant time_s, never below the wanted force, at most F_max; its current (wc_clutch.c lead_film)."""
         cal = self.cal
@@ -62,12 +69,13 @@ class ClutchReference:
         if not self.hbar > target:
             return current
         contact = cal.friction_area * float(film_contact_pressure_Pa(cal, self.hbar)[0])
-        squeeze = float(film_damping_N_s_m2(cal, theta)) * (self.hbar - target) / (time_s * self.hbar ** 3)
+        squeeze = (float(film_damping_N_s_m2(cal, theta)) * corr.film_factor * (self.hbar - target)
+                   / (time_s * self.hbar ** 3))
         force = contact + squeeze
         if not force > force_cmd:
             return current
         force = min(force, force_max_N(cal))
-        pressure = (force + cal.return_spring_force) / cal.piston_area
+        pressure = (max(force + corr.kiss_offset_N, 0.0) + cal.return_spring_force) / cal.piston_area
         return min(max(pressure / cal.vfs_gain, cal.vfs_current_min), cal.vfs_current_max)
 
     def _lead_lag(self, time_s: float, current: float) -> tuple[float, int]:
@@ -86,13 +94,16 @@ class ClutchReference:
 
     def step(self, slip_rpm: float, oil_degC: float, housing_degC: float, request_Nm: float, mode: int,
              bench_force_N: float = math.nan, bench_torque_Nm: float = math.nan, lag_compensation_time_s: float = 0.0,
-             theta_from_oil: bool = False, carried_torque_Nm: float = 0.0) -> dict:
+             theta_from_oil: bool = False, carried_torque_Nm: float = 0.0,
+             correction: Correction | None = None) -> dict:
         cal = self.cal
+        corr = effective(correction)
         lockup = self.lockup
         theta_model = oil_degC if theta_from_oil else self.theta
         if mode == MODE_TORQUE:
-            inv = (holding_inverse(cal, theta_model, request_Nm) if lockup.locked
-                   else inverse(cal, slip_rpm, theta_model, request_Nm))
+            inv = (holding_inverse(cal, theta_model, request_Nm, corr.friction_factor, corr.kiss_offset_N)
+                   if lockup.locked else inverse(cal, slip_rpm, theta_model, request_Nm, corr.friction_factor,
+                                                 corr.kiss_offset_N))
             current, force_cmd, status = float(inv["current_mA"]), float(inv["force_N"]), int(inv["status"])
         else:
             current = cal.vfs_current_max if mode == MODE_LOCKED else cal.vfs_current_min
@@ -100,7 +111,7 @@ class ClutchReference:
             status = 0
         lead = mode == MODE_TORQUE and lag_compensation_time_s > 0.0
         if lead:
-            current = self._lead_film(theta_model, lag_compensation_time_s, force_cmd, current)
+            current = self._lead_film(theta_model, lag_compensation_time_s, force_cmd, current, corr)
         target = cal.vfs_gain * current
         if lead:
             current, clamped = self._lead_lag(lag_compensation_time_s, current)
@@ -110,23 +121,29 @@ class ClutchReference:
         force = max(pressure * cal.piston_area - cal.return_spring_force, 0.0)
         if not math.isnan(bench_force_N):
             force = bench_force_N
+        force = max(force - corr.kiss_offset_N, 0.0)    # DESIGN 12: the contact side of the kiss point
         # inside the lock band the torque keeps the lock direction (the slip's sign there is noise)
         in_band = abs(slip_rpm) * RAD_S_PER_RPM < cal.lock_slip
         if self.film_on:
             contact = cal.friction_area * float(film_contact_pressure_Pa(cal, self.hbar)[0])
-            parts = torque_parts(cal, abs(slip_rpm), theta_model, contact, hbar_m=self.hbar)
-            self.hbar = film_advance_m(cal, self.hbar, force, theta_model)
+            parts = torque_parts(cal, abs(slip_rpm), theta_model, contact, hbar_m=self.hbar,
+                                 friction_factor=corr.friction_factor)
+            self.hbar = film_advance_m(cal, self.hbar, force, theta_model,
+                                       squeeze_factor=cal.film_squeeze_factor * corr.film_factor)
         else:
             contact = force
-            parts = torque_parts(cal, abs(slip_rpm), theta_model, force)
-        torque = float(parts["torque_Nm"]) * (lockup.direction if in_band else (-1.0 if slip_rpm < 0.0 else 1.0))
-        capacity = float(static_capacity_Nm(cal, theta_model, contact))
+            parts = torque_parts(cal, abs(slip_rpm), theta_model, force, friction_factor=corr.friction_factor)
+        sign = lockup.direction if in_band else (-1.0 if slip_rpm < 0.0 else 1.0)
+        torque = float(parts["torque_Nm"]) * sign
+        coulomb = abs(float(parts["coulomb_Nm"])) * sign
+        capacity = float(static_capacity_Nm(cal, theta_model, contact)) * corr.friction_factor
         bench_torque = not math.isnan(bench_torque_Nm)
         carried = 0.0 < carried_torque_Nm <= TORQUE_MAX_NM   # else the request (wc_clutch_step)
         required = bench_torque_Nm if bench_torque else lockup.direction * (carried_torque_Nm if carried else request_Nm)
         slip_rad_s = slip_rpm * RAD_S_PER_RPM
         if lockup.update(slip_rad_s, required, capacity):
             torque = lockup.torque_Nm(required, capacity)
+            coulomb = torque               # static friction only (wc_clutch_step)
             status |= STATUS_LOCKED
             power = 0.0
         else:
@@ -144,7 +161,10 @@ class ClutchReference:
         return {"current_mA": current, "pressure_command_Pa": target, "pressure_model_Pa": pressure,
                 "force_command_N": force_cmd, "theta_degC": theta_used, "torque_Nm": torque,
                 "mu_f": float(parts["mu_f"]), "hbar_m": float(parts["hbar_m"]), "contact_force_N": contact,
-                "static_capacity_Nm": capacity, "status": status}
+                "static_capacity_Nm": capacity, "status": status,
+                # the adaptation's samples (reference/adaptation.py): the Coulomb part, per newton of contact
+                "coulomb_Nm": coulomb,
+                "coulomb_per_N": cal.effective_radius * cal.friction_pairs * float(parts["mu_f"])}
 
 
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,

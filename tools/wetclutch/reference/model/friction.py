@@ -44,11 +44,12 @@ def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
             * cal.effective_radius * cal.friction_pairs * np.asarray(contact_force_N, dtype=float))
 
 
-def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None):
+def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, friction_factor: float = 1.0):
     """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
 
     hbar_m: the film the contact force stands on; default the steady film of eq. 16 (the squeeze-film
-    state of DESIGN 9 passes its own).
+    state of DESIGN 9 passes its own). friction_factor: the adaptation's scale of mu_f (DESIGN 12; the
+    returned mu_f carries it).
 
     Torques carry the sign of the slip speed (slip >= 0 counts as positive):
     the torque transmitted through the slipping clutch, which acts against
@@ -60,7 +61,7 @@ def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None):
     theta = np.asarray(theta_degC, dtype=float)
     sign = np.where(slip < 0.0, -1.0, 1.0)
     speed = cal.effective_radius * np.abs(slip) * RAD_S_PER_RPM          # eq. 4
-    mu_f = friction_coefficient(cal, speed, theta)                       # eq. 18
+    mu_f = friction_coefficient(cal, speed, theta) * friction_factor     # eq. 18 (x the learned scale)
     hbar = (hbar_from_pressure_m(cal, force / cal.friction_area)          # eq. 9, 15, 16
             if hbar_m is None else np.asarray(hbar_m, dtype=float))
     rn = cal.effective_radius * cal.friction_pairs

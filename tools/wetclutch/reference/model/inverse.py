@@ -14,8 +14,13 @@ if TYPE_CHECKING:   # annotations only: the model reads a calibration's attribut
     from ...calibration.parameters import Calibration
 
 
-def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
+def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm, friction_factor: float = 1.0,
+            kiss_offset_N: float = 0.0):
     """Torque request (magnitude, Nm) -> contact force -> piston pressure -> VFS current.
+
+    friction_factor, kiss_offset_N: the adaptation's correction (model/correction.py): mu_f times the factor,
+    the contact force F commanded as the pressure of the apply force F + kiss_offset_N, never below 0 (DESIGN 2,
+    12: the return spring holds the pack open; a negative offset below -F is not commanded).
 
     Returns a dict: force_N, pressure_Pa, current_mA, status (bits above).
     Solves |T(F)| = request exactly. Where the film is clamped (p_c below the
@@ -32,7 +37,7 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
 
     speed = cal.effective_radius * slip * RAD_S_PER_RPM
     arm = cal.effective_radius * cal.friction_pairs
-    coulomb_per_N = arm * friction_coefficient(cal, speed, theta)              # eq. 6, 18
+    coulomb_per_N = arm * friction_coefficient(cal, speed, theta) * friction_factor   # eq. 6, 18 (DESIGN 12)
     viscous_m = arm * viscosity_Pa_s(cal, theta) * cal.friction_area * speed   # eq. 7 times h_bar
 
     def torque_at(force):
@@ -62,7 +67,8 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
     force = np.where(below, 0.0, np.where(above, f_max, force))
     status |= np.where(below, STATUS_BELOW_DRAG, 0)
     status |= np.where(above, STATUS_SATURATED, 0)
-    pressure = (force + cal.return_spring_force) / cal.piston_area   # F_app = P A_p - F_s
+    apply = np.maximum(force + kiss_offset_N, 0.0)                    # DESIGN 12: the kiss point's offset
+    pressure = (apply + cal.return_spring_force) / cal.piston_area   # F_app = P A_p - F_s
     current = pressure / cal.vfs_gain                                 # P = K i
     clamped = (current < cal.vfs_current_min) | (current > cal.vfs_current_max)
     current = np.clip(current, cal.vfs_current_min, cal.vfs_current_max)
@@ -70,16 +76,21 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm):
     return {"force_N": force, "pressure_Pa": pressure, "current_mA": current, "status": status}
 
 
-def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float) -> dict:
+def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float, friction_factor: float = 1.0,
+                    kiss_offset_N: float = 0.0) -> dict:
     """The inverse for a locked clutch (DESIGN 9): the force whose static capacity holds the request with the
-    holding margin, at most the force at the maximum current (STATUS_SATURATED)."""
-    per_N = float(static_capacity_Nm(cal, theta_degC, 1.0))
+    holding margin, at most the force at the maximum current (STATUS_SATURATED). friction_factor,
+    kiss_offset_N: the adaptation's correction, as in inverse()."""
+    per_N = float(static_capacity_Nm(cal, theta_degC, 1.0)) * friction_factor
     force = torque_Nm * (1.0 + cal.holding_margin) / per_N
     if not force <= force_max_N(cal):   # the maximum current itself (wc_inverse_holding)
-        return {"force_N": force_max_N(cal), "pressure_Pa": cal.vfs_gain * cal.vfs_current_max,
-                "current_mA": cal.vfs_current_max, "status": STATUS_SATURATED}
-    status = 0
-    pressure = (force + cal.return_spring_force) / cal.piston_area
+        if kiss_offset_N == 0.0:
+            return {"force_N": force_max_N(cal), "pressure_Pa": cal.vfs_gain * cal.vfs_current_max,
+                    "current_mA": cal.vfs_current_max, "status": STATUS_SATURATED}
+        force, status = force_max_N(cal), STATUS_SATURATED   # F_max commanded with the kiss offset too
+    else:
+        status = 0
+    pressure = (max(force + kiss_offset_N, 0.0) + cal.return_spring_force) / cal.piston_area
     current = pressure / cal.vfs_gain
     if current < cal.vfs_current_min or current > cal.vfs_current_max:
         status |= STATUS_CURRENT_CLAMPED
