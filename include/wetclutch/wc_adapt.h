@@ -30,7 +30,11 @@
  * The window: from adapt_window_skip_s after the inertia phase's start (the
  * off-going clutch's last torque) while the slip stays above
  * min_start_slip_rad_s (near the lock the plant may stick: no kinetic
- * torque), to the end of the inertia phase.
+ * torque), to the end of the inertia phase; the window closes for good at
+ * the first slip at or below it (a slip that comes back is not paired with
+ * the sample before the gap). A sample with a non-finite value marks the
+ * window invalid (fault) and is not used. The early part (the film factor's)
+ * is the samples j with (j - 1) dt < adapt_film_window_s.
  *
  * The update (wc_adapt_finish), of a valid shift only: completed (no abort,
  * so no safe state), no invalid input during the window, at least one sample,
@@ -127,7 +131,8 @@ typedef struct {
 /* The running window of the inertia phase (reset at each shift's start). */
 typedef struct {
     bool started;                   /* the window's first sample is in */
-    bool fault;                     /* an invalid input in the window */
+    bool fault;                     /* an invalid input (status bit or non-finite value) in the window */
+    bool closed;                    /* the slip fell to min_start_slip_rad_s: no more samples this shift */
     uint32_t samples;
     float slip_start_rad_s;         /* at the window's start */
     float slip_prev_rad_s;
@@ -136,7 +141,6 @@ typedef struct {
     float coulomb_prev_Nm;
     float coulomb_per_N_prev;
     float theta_prev_degC;
-    float elapsed_s;                /* since the window's start */
     float sum_model_Nm;             /* sums over the window's samples */
     float sum_implied_Nm;
     float sum_model_early_Nm;       /* over its first adapt_film_window_s */

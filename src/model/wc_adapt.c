@@ -87,7 +87,7 @@ wc_model_correction_t wc_adapt_correction(const wc_adapt_t *adapt, const wc_shif
 void wc_adapt_begin(wc_adapt_t *adapt)
 {
     if (adapt == NULL) { return; }
-    static const wc_adapt_window_t empty = { false, false, 0u, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
+    static const wc_adapt_window_t empty = { false, false, false, 0u, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f,
                                              0.0f, 0.0f, 0.0f, 0.0f, { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f },
                                              0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
     adapt->window = empty;
@@ -102,7 +102,18 @@ void wc_adapt_sample(wc_adapt_t *adapt, const wc_shift_calibration_t *cal, float
     if (elapsed_s < cal->adapt_window_skip_s) { return; }
     const wc_status_t invalid = WC_STATUS_SLIP_INVALID | WC_STATUS_THETA_INVALID | WC_STATUS_TORQUE_INVALID;
     if ((out->status & invalid) != 0u) { w->fault = true; }  /* a glitch: this shift teaches nothing */
-    if (!(slip_rad_s > cal->min_start_slip_rad_s)) { return; }  /* near the lock the plant may stick */
+    const bool finite = isfinite(slip_rad_s) && isfinite(drive_rad_s2) && isfinite(inverse_inertia) &&
+                        isfinite(out->model.torque_Nm) && isfinite(out->model.coulomb_Nm) &&
+                        isfinite(out->contact_force_N) && isfinite(out->theta_degC);
+    if (!finite) {
+        w->fault = true;
+        return;
+    }
+    if (w->closed) { return; }
+    if (!(slip_rad_s > cal->min_start_slip_rad_s)) {  /* near the lock the plant may stick: the window ends */
+        w->closed = w->started;
+        return;
+    }
     const float dt_s = clutch->model.cal->control_period_s;
     if (w->started) {
         /* DESIGN 12 (wc_adapt.h): the torque the driveline implies over the
@@ -112,7 +123,7 @@ void wc_adapt_sample(wc_adapt_t *adapt, const wc_shift_calibration_t *cal, float
         w->samples++;
         w->sum_model_Nm += model_Nm;
         w->sum_implied_Nm += implied_Nm;
-        if (w->elapsed_s < cal->adapt_film_window_s) {
+        if ((float)(w->samples - 1u) * dt_s < cal->adapt_film_window_s) {  /* the first samples: exact */
             w->sum_model_early_Nm += model_Nm;
             w->sum_implied_early_Nm += implied_Nm;
         }
@@ -128,7 +139,6 @@ void wc_adapt_sample(wc_adapt_t *adapt, const wc_shift_calibration_t *cal, float
         w->s22_Nm2_per_N2 += x2 * x2;
         w->s1r_Nm2 += x1 * r;
         w->s2r_Nm2_per_N += x2 * r;
-        w->elapsed_s += dt_s;
     } else {
         w->started = true;
         w->slip_start_rad_s = slip_rad_s;

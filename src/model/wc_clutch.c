@@ -82,6 +82,15 @@ static wc_status_t lead_lag(const wc_model_t *model, float pressure_Pa, float ga
     return WC_STATUS_OK;
 }
 
+/* DESIGN 12: the learned kiss point moves the return spring's preload by the
+ * offset, both ways: P = (F + F_s + offset) / A_p, at least 0 (F, offset finite
+ * and bounded: the inverse's force, the accepted correction). */
+static float kiss_pressure_Pa(const wc_calibration_t *cal, float force_N, float kiss_offset_N)
+{
+    const float pressure_Pa = (force_N + cal->return_spring_force_N + kiss_offset_N) / cal->piston_area_m2;
+    return (pressure_Pa > 0.0f) ? pressure_Pa : 0.0f;
+}
+
 /* DESIGN 9, squeeze film, the lead's first half: the apply force that moves
  * the film state h_bar towards the film h_bar* of the wanted contact force
  * as a first-order approach of time t would, from F_app = F_c(h_bar) +
@@ -103,7 +112,7 @@ static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, f
     if (!(force_N > inv->force_N)) { return; }
     force_N = (force_N < model->force_max_N) ? force_N : model->force_max_N;
     /* the pressure of F plus the learned kiss offset (DESIGN 12); the current clamped to the solenoid's range */
-    (void)wc_vfs_current_mA(cal, wc_piston_pressure_Pa(cal, force_N + kiss_offset_N), &inv->current_mA);
+    (void)wc_vfs_current_mA(cal, kiss_pressure_Pa(cal, force_N, kiss_offset_N), &inv->current_mA);
 }
 
 /* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
@@ -132,11 +141,11 @@ static wc_model_correction_t accept_correction(const wc_model_correction_t *c)
     return valid ? *c : none;
 }
 
-/* DESIGN 12: the inverse's contact force commanded with the learned kiss
- * point: the current of the pressure of F + offset, in the solenoid's range. */
+/* The inverse's contact force commanded with the learned kiss point: the
+ * current of that pressure, in the solenoid's range. */
 static wc_status_t shift_kiss(const wc_calibration_t *cal, float kiss_offset_N, wc_inverse_t *inv)
 {
-    inv->pressure_Pa = wc_piston_pressure_Pa(cal, inv->force_N + kiss_offset_N);
+    inv->pressure_Pa = kiss_pressure_Pa(cal, inv->force_N, kiss_offset_N);
     return wc_vfs_current_mA(cal, inv->pressure_Pa, &inv->current_mA);
 }
 
@@ -217,8 +226,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
     if (corrected && nonzero(correction.kiss_offset_N)) {
-        /* DESIGN 12: the learned kiss point; within [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
-        const float moved_N = force_N - correction.kiss_offset_N;
+        /* DESIGN 12: the learned kiss point moves the spring's preload: F = P A_p - F_s - offset, within
+         * [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
+        const wc_calibration_t *c = model->cal;
+        const float moved_N = clutch->pressure_model_Pa * c->piston_area_m2 - c->return_spring_force_N -
+                              correction.kiss_offset_N;
         force_N = (moved_N > 0.0f) ? ((moved_N < WC_FORCE_MAX_N) ? moved_N : WC_FORCE_MAX_N) : 0.0f;
     }
     const bool bench_force = in->bench.valid && wc_in_range(in->bench.apply_force_N, 0.0f, WC_FORCE_MAX_N);

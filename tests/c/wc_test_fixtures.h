@@ -76,7 +76,7 @@
     .adapt_scale_band = 0.3f, .adapt_scale_step = 0.05f, .adapt_scale_gain = 0.6f,                            \
     .adapt_confidence_gain = 0.3f, .adapt_film_factor_min = 0.2f, .adapt_film_factor_max = 5.0f,              \
     .adapt_film_step = 0.3f, .adapt_film_gain = 0.0f, .adapt_kiss_band_Pa = 60e3f,                            \
-    .adapt_kiss_step_Pa = 10e3f, .adapt_kiss_gain = 0.5f, .adapt_window_skip_s = 0.03f,                       \
+    .adapt_kiss_step_Pa = 10e3f, .adapt_kiss_gain = 0.0f, .adapt_window_skip_s = 0.03f,                       \
     .adapt_film_window_s = 0.1f, .adapt_min_slip_drop = 0.5f, .adapt_min_conditioning = 0.05f,
 
 /* Periods in Shift mode with ShiftRequest 0 after wc_loop_init with

@@ -75,7 +75,7 @@ class ClutchReference:
         if not force > force_cmd:
             return current
         force = min(force, force_max_N(cal))
-        pressure = (max(force + corr.kiss_offset_N, 0.0) + cal.return_spring_force) / cal.piston_area
+        pressure = max(force + cal.return_spring_force + corr.kiss_offset_N, 0.0) / cal.piston_area
         return min(max(pressure / cal.vfs_gain, cal.vfs_current_min), cal.vfs_current_max)
 
     def _lead_lag(self, time_s: float, current: float) -> tuple[float, int]:
@@ -118,10 +118,11 @@ class ClutchReference:
             status |= clamped
         self.pressure = cal.vfs_gain * current + (self.pressure - cal.vfs_gain * current) * self.a_vfs
         pressure = self.pressure
-        force = max(pressure * cal.piston_area - cal.return_spring_force, 0.0)
+        # DESIGN 12: the kiss offset moves the spring's preload (0: the calibration's); a bench's load cell
+        # measures the apply force itself
+        force = max(pressure * cal.piston_area - cal.return_spring_force - corr.kiss_offset_N, 0.0)
         if not math.isnan(bench_force_N):
             force = bench_force_N
-        force = max(force - corr.kiss_offset_N, 0.0)    # DESIGN 12: the contact side of the kiss point
         # inside the lock band the torque keeps the lock direction (the slip's sign there is noise)
         in_band = abs(slip_rpm) * RAD_S_PER_RPM < cal.lock_slip
         if self.film_on:

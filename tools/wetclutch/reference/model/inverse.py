@@ -67,8 +67,8 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm, friction_factor: 
     force = np.where(below, 0.0, np.where(above, f_max, force))
     status |= np.where(below, STATUS_BELOW_DRAG, 0)
     status |= np.where(above, STATUS_SATURATED, 0)
-    apply = np.maximum(force + kiss_offset_N, 0.0)                    # DESIGN 12: the kiss point's offset
-    pressure = (apply + cal.return_spring_force) / cal.piston_area   # F_app = P A_p - F_s
+    # F_app = P A_p - F_s; DESIGN 12: the kiss offset moves the spring's preload, the pressure at least 0
+    pressure = np.maximum(force + cal.return_spring_force + kiss_offset_N, 0.0) / cal.piston_area
     current = pressure / cal.vfs_gain                                 # P = K i
     clamped = (current < cal.vfs_current_min) | (current > cal.vfs_current_max)
     current = np.clip(current, cal.vfs_current_min, cal.vfs_current_max)
