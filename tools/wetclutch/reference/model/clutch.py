@@ -40,10 +40,9 @@ class ClutchReference:
     [THETA_MIN_DEGC, THETA_MAX_DEGC], STATUS_OVER_TEMPERATURE above THETA_OVER_DEGC until it falls
     THETA_OVER_HYSTERESIS_K below. theta_from_oil: the model takes the oil temperature (thermal-blind).
     correction: the adaptation's (model/correction.py, DESIGN 12): mu_f scaled in the torque, the inverse and
-    the static capacity, the film's damping scaled in its advance and the film lead, the contact force the
-    apply force (itself at least 0, DESIGN 2) minus the kiss offset, at least 0, and the wanted contact force
-    commanded at the pressure of the apply force itself plus the offset (at least 0); None or out of range:
-    none.
+    the static capacity, the film's damping scaled in its advance and the film lead, the kiss offset a change
+    of the spring's preload both ways (contact force max(P A_p - F_s - offset, 0), the wanted contact force F
+    commanded at max(F + F_s + offset, 0) / A_p); None or out of range: none.
     The inputs are taken as valid (the frame loop's reference, hil/replay.py, holds invalid ones)."""
 
     def __init__(self, cal: Calibration, theta_start_degC: float):
