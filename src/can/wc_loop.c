@@ -389,7 +389,8 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
         wc_shift_init(&loop->shift);  /* a finished shift ends with its mode: the new mode acts now */
     }
     /* DESIGN 12: a reset of the learned values on a 0 -> 1 edge of the (valid) AdaptationReset, not during a shift */
-    const bool reset = (loop->config.shift != NULL) && shift_mode && (loop->shift_command.adaptation_reset > 0.5f);
+    const bool reset = (loop->config.shift != NULL) && (loop->config.shift->adaptation == 1u) && shift_mode &&
+                       (loop->shift_command.adaptation_reset > 0.5f);
     if (reset && !loop->last_adaptation_reset && !shift_running && !safe) {
         wc_adapt_reset(&loop->adapt);
         loop->adapt.status |= WC_ADAPT_STATUS_RESET;

@@ -13,7 +13,8 @@
  *           (40, -40, 250 degC or NaN); bit 6 a fuzzed loop configuration
  *           (timeouts, E2E MaxDeltaCounter/SyncCounter, recovery) follows in
  *           bytes 1-5, else WC_LOOP_CONFIG_DEFAULT; bit 7 shift control on
- *           (config.shift = shift_1_2 full; bench input off, and the
+ *           (config.shift = shift_1_2 full, or with bit 1 shift_1_2 adaptive:
+ *           adaptation on, DESIGN 12; bench input off, and the
  *           BenchMeasurement choice of the frame id below is ShiftCommand,
  *           E2E-valid and plausible like the other control frames, Mode 0..3).
  *   then records until the bytes run out (at most MAX_RECORDS), each a
@@ -43,8 +44,10 @@
  *    ends only after both inputs were fresh for recovery_periods steps in a
  *    row; in the safe state the current is the calibration's minimum;
  *    StatusBenchInput only with bench input enabled;
- *  - with shift control a step may add a third frame, ShiftReport (0x122),
- *    which decodes (SNA-free, saturated at most);
+ *  - with shift control a step may add ShiftReport (0x122) and, with
+ *    adaptation, AdaptationReport (0x123; alone after a reset), which decode
+ *    (SNA-free, saturated at most); with adaptation the learned values stay
+ *    inside their bands (wc_adapt_values_valid) after every step;
  *  - counters: frames_used + sum(rejected) + frames still queued ==
  *    frames_in; frames_out == the frames the steps returned.
  * At the end one more tick empties the ring and the counters must add up
@@ -265,15 +268,29 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
     const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
                                    (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
-    const bool report = h->shift && (n == WC_LOOP_TX_FRAMES);
-    FZ_CHECK(n == (expected ? (report ? WC_LOOP_TX_FRAMES : WC_LOOP_TX_CYCLIC) : 0u),
-             "wc_loop_iterate returned %u, expected %u", (unsigned)n, expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u);
-    if (report) {
-        FZ_CHECK((out[2].id == WC_CAN_SHIFT_REPORT_FRAME_ID) && (out[2].dlc == 8u) && (out[2].flags == 0u),
-                 "third frame id 0x%x dlc %u", (unsigned)out[2].id, (unsigned)out[2].dlc);
-        wc_can_shift_report_phys_t q;
-        const wc_can_result_t rq = wc_can_decode_shift_report(&q, out[2].data, out[2].dlc);
-        FZ_CHECK(!wc_can_is_error(rq), "ShiftReport does not decode cleanly (result %d)", (int)rq);
+    const bool adaptive = h->shift && (h->config.shift->adaptation == 1u);
+    const uint32_t most = !h->shift ? WC_LOOP_TX_CYCLIC : (adaptive ? WC_LOOP_TX_FRAMES : WC_LOOP_TX_CYCLIC + 1u);
+    FZ_CHECK(expected ? ((n >= WC_LOOP_TX_CYCLIC) && (n <= most)) : (n == 0u),
+             "wc_loop_iterate returned %u, expected %u..%u", (unsigned)n, expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u,
+             expected ? (unsigned)most : 0u);
+    for (uint32_t i = WC_LOOP_TX_CYCLIC; expected && (i < n); ++i) {
+        FZ_CHECK((out[i].dlc == 8u) && (out[i].flags == 0u), "frame %u dlc %u flags %u", (unsigned)i,
+                 (unsigned)out[i].dlc, (unsigned)out[i].flags);
+        if (out[i].id == WC_CAN_SHIFT_REPORT_FRAME_ID) {
+            FZ_CHECK(i == WC_LOOP_TX_CYCLIC, "ShiftReport at position %u", (unsigned)i);
+            wc_can_shift_report_phys_t q;
+            const wc_can_result_t rq = wc_can_decode_shift_report(&q, out[i].data, out[i].dlc);
+            FZ_CHECK(!wc_can_is_error(rq), "ShiftReport does not decode cleanly (result %d)", (int)rq);
+        } else {
+            FZ_CHECK(adaptive && (out[i].id == WC_CAN_ADAPTATION_REPORT_FRAME_ID), "frame %u id 0x%x", (unsigned)i,
+                     (unsigned)out[i].id);
+            wc_can_adaptation_report_phys_t a;
+            const wc_can_result_t ra = wc_can_decode_adaptation_report(&a, out[i].data, out[i].dlc);
+            FZ_CHECK(!wc_can_is_error(ra), "AdaptationReport does not decode cleanly (result %d)", (int)ra);
+        }
+    }
+    if (adaptive) {
+        FZ_CHECK(wc_adapt_values_valid(&loop.adapt.values, h->config.shift), "learned values outside their bands");
     }
     h->frames_out += n;
     if (n >= WC_LOOP_TX_CYCLIC) {
@@ -306,7 +323,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     h.shift = (options & 0x80u) != 0u;
     h.config.bench_input_enabled = ((options & 0x02u) != 0u) && !h.shift;
-    h.config.shift = h.shift ? &wc_shift_1_2_full : NULL;
+    h.config.shift = !h.shift ? NULL : (((options & 0x02u) != 0u) ? &wc_shift_1_2_adaptive : &wc_shift_1_2_full);
 
     fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
     fz_arg(theta_start);
