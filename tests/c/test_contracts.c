@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "wc_table1_calibration.h"
+#include "wc_test_fixtures.h"
 #include "wetclutch_can/wc_loop.h"
 
 static wc_step_input_t torque_input(void)
@@ -102,6 +103,30 @@ static void test_loop_contracts(void **state)
     assert_int_equal(wc_loop_step(&loop, out), WC_LOOP_TX_CYCLIC);
 }
 
+/* DESIGN 12: the adaptation's entry points. NULL instance: reset and the image
+ * functions assert; the shift controller's calls take NULL as "no adaptation"
+ * (documented in wc_adapt.h / wc_shift.h) and change nothing. */
+static void test_adaptation_contracts(void **state)
+{
+    (void)state;
+    static const wc_shift_calibration_t cal = WC_TEST_SHIFT_CALIBRATION;
+    wc_adapt_t adapt;
+    uint8_t image[WC_ADAPT_IMAGE_BYTES];
+    expect_assert_failure(wc_adapt_reset(NULL));
+    expect_assert_failure(wc_adapt_image_load(NULL, &cal, 0u, image, sizeof image));
+    expect_assert_failure(wc_adapt_image_load(&adapt, NULL, 0u, image, sizeof image));
+    expect_assert_failure(wc_adapt_image_write(NULL, 0u, image, sizeof image));
+    wc_clutch_t clutch;
+    assert_int_equal(wc_clutch_init(&clutch, &wc_table1_calibration, 40.0f), WC_CAL_OK);
+    const wc_model_correction_t none = wc_adapt_correction(NULL, &cal, &clutch, 80.0f);
+    assert_float_equal(none.friction_scale_delta, 0.0f, 0.0f);
+    assert_float_equal(none.film_factor_delta, 0.0f, 0.0f);
+    assert_float_equal(none.kiss_offset_N, 0.0f, 0.0f);
+    wc_adapt_begin(NULL);
+    const wc_adapt_change_t off = wc_adapt_finish(NULL, &cal, 0u, &clutch);
+    assert_int_equal(off.result, WC_ADAPT_RESULT_OFF);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -110,6 +135,7 @@ int main(void)
         cmocka_unit_test(test_clutch_step_uninitialised_asserts),
         cmocka_unit_test(test_clutch_step_after_failed_init_asserts),
         cmocka_unit_test(test_model_functions_assert_on_unusable_model),
+        cmocka_unit_test(test_adaptation_contracts),
         cmocka_unit_test(test_loop_contracts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
