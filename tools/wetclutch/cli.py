@@ -213,6 +213,8 @@ def _cmd_shift(args) -> int:
     except plant.PlantError as e:
         print(f"wetclutch shift: {e}", file=sys.stderr)
         return 2
+    if args.adaptation_study:
+        return _adaptation_study(args)
     if args.tune_feedback:
         res = shift.tune_feedback(args.plant)
         for g in res["grid"]:
@@ -223,11 +225,39 @@ def _cmd_shift(args) -> int:
         print(f"best ({res['criterion']}): kp {b['kp']:g} Nm/(rad/s), ki {b['ki']:g} Nm/rad"
               " -> [variants.feedback] of tools/calibrations/shift_1_2.toml")
         return 0
-    metrics = shift.report(Path(args.out), plant_path=args.plant)
-    print(Path(args.out, "shift_report.md").read_text())
-    print(f"wrote {args.out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"]))
+    out = Path(args.out or "out/shift")
+    metrics = shift.report(out, plant_path=args.plant)
+    print((out / "shift_report.md").read_text())
+    print(f"wrote {out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"]))
     if metrics["missed"]:
         print("wetclutch shift: targets missed: " + ", ".join(metrics["missed"]), file=sys.stderr)
+        return 1
+    return 0
+
+
+def _adaptation_study(args) -> int:
+    """wetclutch shift --adaptation-study: the study, its report and plots; exit 1 when a target is missed."""
+    from .shift import adaptation_report, adaptation_study
+    from .simulate.plant import variants
+    try:
+        for name in args.variants or ():
+            variants.variant(name)
+    except KeyError as e:
+        print(f"wetclutch shift: {e.args[0]}", file=sys.stderr)
+        return 2
+    if args.shifts < adaptation_study.LEARN_SHIFTS + 1:
+        print(f"wetclutch shift: --shifts {args.shifts}: at least {adaptation_study.LEARN_SHIFTS + 1} (the learning"
+              " shifts, then the comparison)", file=sys.stderr)
+        return 2
+    out = Path(args.out or "out/adaptation_study")
+    res = adaptation_study.run_study(out, args.variants, args.shifts, plant_path=args.plant,
+                                     progress=lambda text: print(text, file=sys.stderr, flush=True))
+    plots = adaptation_report.write(out, res)
+    print((out / "adaptation_study.md").read_text())
+    print(f"wrote {out}/adaptation_study.md, adaptation_study.json, " + ", ".join(Path(p).name for p in plots))
+    left = adaptation_study.missed(res["targets"])
+    if left:
+        print("wetclutch shift: adaptation targets missed: " + ", ".join(left), file=sys.stderr)
         return 1
     return 0
 
@@ -289,9 +319,19 @@ def build_parser() -> argparse.ArgumentParser:
                        " (c) 2-DOF full model over the scenario matrix (issue 13); exit 1 when a target is missed")
     q.add_argument("--plant", default=str(Path(__file__).resolve().parents[1] / "plants" / "upshift_1_2.toml"),
                    help="plant TOML (default tools/plants/upshift_1_2.toml)")
-    q.add_argument("--out", default="out/shift", help="output directory (default out/shift)")
+    q.add_argument("--out", help="output directory (default out/shift; with --adaptation-study out/adaptation_study)")
     q.add_argument("--tune-feedback", action="store_true",
                    help="only the gain search of (a): kp x ki grid on the nominal scenario, print the best")
+    q.add_argument("--adaptation-study", action="store_true",
+                   help="the adaptation study (issue 20): consecutive shifts with adaptation on plant variants that"
+                        " differ from the calibration, the matrix from the learned values, faults, heat soak;"
+                        " plots of the learned values against their truth; exit 1 when a target is missed")
+    q.add_argument("--variants", nargs="+", metavar="NAME",
+                   help="with --adaptation-study: the plant variants (default all: base, friction-20, friction-10,"
+                        " friction+10, friction+20, film0.3, film3, kiss+15, aged)")
+    q.add_argument("--shifts", type=int, default=16, metavar="N",
+                   help="with --adaptation-study: consecutive shifts per variant (default 16; 200 for the settling"
+                        " target, about 2 minutes per variant)")
     q.set_defaults(func=_cmd_shift)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")

@@ -32,6 +32,9 @@ Quality per shift, from the plant's truth (DESIGN 10):
                    Butterworth, zero phase): the band ride-comfort ratings
                    weight (ISO 2631-1 up to about 8 Hz), above it driveline
                    ringing the occupants do not feel as jerk;
+  peak_inertia_jerk_m_s3  the same over the inertia phase only: from its start to
+                   synchronisation (the torque phase's jerk, shared by the
+                   controllers, is the whole-shift figure's);
   friction_energy_kJ, peak_theta_degC (true pack temperature);
   flare            turbine speed above the 1st-gear synchronous speed by more
                    than FLARE_RPM (the engine runs up: too little clutch torque);

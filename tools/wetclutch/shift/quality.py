@@ -28,6 +28,7 @@ def quality(rec: dict, target_s: float = TARGET_INERTIA_S) -> dict:
     err = rec["true_slip_rad_s"][ki:k_end] - rec["reference_slip_rad_s"][ki:k_end]
     accel = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
     jerk = np.gradient(accel, dt)
+    k_jerk_end = k_sync + 1 if k_sync is not None else len(jerk)
     flare_rpm = float(np.max(rec["true_turbine_speed_rpm"][k0:] - rec["true_gear1_speed_rpm"][k0:]))
     t_t = max(abs(float(np.mean(rec["true_turbine_torque_Nm"]))), 1.0)
     fight = float(np.max(np.maximum(-rec["true_offgoing_torque_Nm"][k0:], 0.0)))
@@ -39,6 +40,7 @@ def quality(rec: dict, target_s: float = TARGET_INERTIA_S) -> dict:
         "inertia_time_error": (inertia - target_s) / target_s if math.isfinite(inertia) else float("nan"),
         "slip_rmse_rpm": float(np.sqrt(np.mean(err ** 2)) / plant_mod.RPM) if err.size else float("nan"),
         "peak_jerk_m_s3": float(np.max(np.abs(jerk[k0:]))),
+        "peak_inertia_jerk_m_s3": float(np.max(np.abs(jerk[ki:k_jerk_end]))),
         "friction_energy_kJ": float(np.sum(rec["true_friction_power_W"][k0:]) * dt * 1e-3),
         "peak_theta_degC": float(np.max(rec["true_theta_clutch_degC"][k0:])),
         "peak_theta_estimate_degC": float(np.max(rec["theta_estimate_degC"][k0:])),
@@ -58,8 +60,8 @@ def worst(qs: list[dict]) -> dict:
     if len(qs) == 1:
         return dict(qs[0])
     out = dict(qs[-1])
-    for key in ("slip_rmse_rpm", "peak_jerk_m_s3", "peak_theta_degC", "friction_energy_kJ", "pressure_rmse_kPa",
-                "flare_rpm", "tie_up_Nm"):
+    for key in ("slip_rmse_rpm", "peak_jerk_m_s3", "peak_inertia_jerk_m_s3", "peak_theta_degC", "friction_energy_kJ",
+                "pressure_rmse_kPa", "flare_rpm", "tie_up_Nm"):
         out[key] = max(q[key] for q in qs)
     out["inertia_time_error"] = max((q["inertia_time_error"] for q in qs), key=lambda e: abs(e) if math.isfinite(e) else 1e9)
     out["inertia_time_s"] = max((q["inertia_time_s"] for q in qs),

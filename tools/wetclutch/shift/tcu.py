@@ -13,15 +13,27 @@ class InprocTcu:
     """The frame loop in-process: wc_replay --lockstep through a pipe."""
 
     def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
-                 calibration: str = TCU_CALIBRATION, program: Path = WC_REPLAY):
+                 calibration: str = TCU_CALIBRATION, program: Path = WC_REPLAY, adaptation_file: Path | None = None):
+        """adaptation_file: wc_replay --adaptation-file, the learned values (DESIGN 12) read at the start and
+        written (atomically) at each shift's end; None: none (the calibration's values, nothing written)."""
         if not Path(program).is_file():
             raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
         cmd = [str(program), "-", "--lockstep", "--calibration", calibration, "--theta-start",
                f"{theta_start_degC:.6g}", "--shift", shift_name]
         for k, v in (overrides or {}).items():
             cmd += ["--set", f"{k}={v:.9g}"]
+        if adaptation_file is not None:
+            cmd += ["--adaptation-file", str(adaptation_file)]
         self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      text=True, bufsize=1)
+
+    @staticmethod
+    def supports_adaptation_file(program: Path = WC_REPLAY) -> bool:
+        """wc_replay takes --adaptation-file (its usage text names it)."""
+        if not Path(program).is_file():
+            return False
+        res = subprocess.run([str(program)], capture_output=True, text=True)
+        return "--adaptation-file" in res.stdout + res.stderr
 
     def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
         lines = "".join(f"({t_s:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n" for m in frames)
@@ -40,6 +52,34 @@ class InprocTcu:
                 return out
             ident, data = line.split()[2].split("#")
             out.append((int(ident, 16), bytes.fromhex(data)))
+
+    def run_open_loop(self, t_s: float, steps, chunk: int = 200) -> list[tuple[int, bytes]]:
+        """Periods whose inputs do not depend on the TCU's outputs (steps: each period's frames), written
+        ahead in chunks (no round trip per period; a chunk's input and output stay below a pipe's buffer)
+        and their outputs read after; returns the last period's output frames."""
+        steps = list(steps)
+        last: list[tuple[int, bytes]] = []
+        for c0 in range(0, len(steps), chunk):
+            part = steps[c0:c0 + chunk]
+            lines = "".join(f"({t_s + (c0 + j) * 1e-3:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n"
+                            for j, frames in enumerate(part) for m in frames)
+            try:
+                self.proc.stdin.write(lines)
+                self.proc.stdin.flush()
+            except BrokenPipeError:
+                raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}") from None
+            for _ in part:
+                last = []
+                while True:
+                    line = self.proc.stdout.readline()
+                    if not line:
+                        raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}")
+                    line = line.strip()
+                    if line == ".":
+                        break
+                    ident, data = line.split()[2].split("#")
+                    last.append((int(ident, 16), bytes.fromhex(data)))
+        return last
 
     def close(self):
         if self.proc.stdin:
