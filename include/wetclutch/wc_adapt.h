@@ -47,9 +47,10 @@
  *     node learns only from the temperatures near it). Then, normalised so
  *     that the interpolated scale at the window's temperatures moves by the
  *     gain times its error (Q = sum_j q_j^2 > 0):
- *         s_i += clip(adapt_scale_gain g_i s_i (rho - 1), +-adapt_scale_step),
+ *         s_i += clip(adapt_scale_gain g_i s_i (rho - 1), +-adapt_scale_step (1 - c_i / 2)),
  *         g_i = max(q_i / Q, 1 - c_i)   (c_i the confidence before the update: a
- *     node not yet learned follows the measurement in full, a smooth prior),
+ *     node not yet learned follows the measurement in full, a smooth prior;
+ *     a confident one moves at most half a step, so one faulty shift costs it less),
  *     clipped to [1 - adapt_scale_band, 1 + adapt_scale_band];
  *         c_i += adapt_confidence_gain q_i (1 - c_i)   (confidence, 0..1).
  *   - kiss point: least squares of the residual r = T_imp - T_model on

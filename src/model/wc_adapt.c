@@ -213,8 +213,9 @@ wc_adapt_change_t wc_adapt_finish(wc_adapt_t *adapt, const wc_shift_calibration_
             const float own = (share_sq > 0.0f) ? (share[i] / share_sq) : 0.0f;
             const float unlearned = 1.0f - v->confidence[i];
             const float weight = (own > unlearned) ? own : unlearned;
-            const float step = clip(cal->adapt_scale_gain * weight * s * (rho - 1.0f), -cal->adapt_scale_step,
-                                    cal->adapt_scale_step);
+            /* a confident node moves at most half a step: one faulty shift costs it less */
+            const float limit = cal->adapt_scale_step * (1.0f - 0.5f * v->confidence[i]);
+            const float step = clip(cal->adapt_scale_gain * weight * s * (rho - 1.0f), -limit, limit);
             v->friction_scale[i] = clip(s + step, 1.0f - band, 1.0f + band);
             v->confidence[i] = clip(v->confidence[i] + cal->adapt_confidence_gain * share[i] * (1.0f - v->confidence[i]),
                                     0.0f, 1.0f);

@@ -48,23 +48,31 @@ def test_slip_within_10_percent_of_the_matched_plant_after_8_shifts(study, varia
     assert t["met"], t
 
 
-# Targets measured and missed (at f6551bb); strict: meeting one turns its test into a failure, so the mark
-# comes off when the controller meets it.
-_FRICTION_10 = ("missed: in the matrix's friction+10pct scenario (a new 10 % friction error in one shift, which"
-                " the adaptation can only learn for the next) feedback-only tracks slip better, as in issue 13;")
+def _beats(study, variant: str, metric: str) -> dict:
+    """(feedback or blind) / adaptive of one figure in every scenario of the matrix (> 1: adaptive better)."""
+    ratios = study[1]["targets"][variant]["beats_feedback_blind"]["ratios"]
+    return {f"{sc} {k}": r for sc, rs in ratios.items() for k, r in rs.items() if k.startswith(metric)}
 
 
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_beats_feedback_and_thermal_blind_on_slip_in_every_scenario(study, variant):
+    """Slip RMSE, (feedback or blind) / adaptive > 1 in every scenario, the friction -/+10 % ones from the
+    image relearned on that plant in LEARN_SHIFTS shifts."""
+    worse = {k: r for k, r in _beats(study, variant, "slip_rmse_rpm").items() if not r > 1.0}
+    assert not worse, worse
+
+
+# Measured and missed at the commit that added this mark; strict: meeting it turns the test into a failure,
+# so the mark comes off when the controller meets it.
 @pytest.mark.parametrize("variant", [
-    pytest.param("friction+20", marks=pytest.mark.xfail(strict=True, reason=_FRICTION_10 + " slip RMSE"
-                 " feedback/adaptive 0.81; the inertia phase's peak jerk blind/adaptive 0.93 at 110 degC oil and"
-                 " 0.99-1.00 in friction+10pct, load25 and the soak")),
-    pytest.param("aged", marks=pytest.mark.xfail(strict=True, reason=_FRICTION_10 + " slip RMSE feedback/adaptive"
-                 " 0.95; inertia-phase peak jerk blind/adaptive 0.996 at 25 % load")),
-])
-def test_beats_feedback_and_thermal_blind_in_every_scenario(study, variant):
-    """Slip RMSE and the inertia phase's peak jerk, (feedback or blind) / adaptive > 1 in every scenario."""
-    t = study[1]["targets"][variant]["beats_feedback_blind"]
-    assert t["met"], t["missed"]
+    pytest.param(v, marks=pytest.mark.xfail(strict=True, reason=(
+        "missed: the inertia phase's peak jerk is the reference trajectory's (its deceleration ramp, 130-150 ms"
+        " into the phase), which the adaptive controller follows and the thermal-blind one, tracking 2x worse,"
+        " departs from: blind/adaptive 0.93-1.00 in oil110, load25, friction+10pct and the soak")))
+    for v in VARIANTS])
+def test_beats_feedback_and_thermal_blind_on_inertia_jerk_in_every_scenario(study, variant):
+    worse = {k: r for k, r in _beats(study, variant, "peak_inertia_jerk_m_s3").items() if not r > 1.0}
+    assert not worse, worse
 
 
 def test_never_worse_on_the_matched_plant(study):
@@ -77,11 +85,7 @@ def test_learned_values_stay_inside_their_bands(study, variant):
     assert study[1]["targets"][variant]["inside_bands"]["met"]
 
 
-@pytest.mark.parametrize("fault", [
-    pytest.param(f.name, marks=pytest.mark.xfail(strict=True, reason="missed: the torque estimate 20 % high is taken"
-                 " as plausible (torque ratio 1.17, inside 0.5..2) and moves the friction scale by its full step"
-                 " 0.05; 5 good shifts leave 0.016 of it (the criterion: 0.0125, a quarter step)"))
-    if f.name == "torque+20" else f.name for f in adaptation_runs.FAULTS])
+@pytest.mark.parametrize("fault", [f.name for f in adaptation_runs.FAULTS])
 def test_a_fault_moves_a_value_by_at_most_its_step_and_5_good_shifts_recover_it(study, fault):
     c = study[1]["targets"]["faults"]["cases"][fault]
     assert c["met"], c

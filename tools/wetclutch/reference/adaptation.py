@@ -13,7 +13,7 @@ The measurement (DESIGN 10, 12): in the inertia phase
 paired with the model torque of period j-1. The update at the shift's end (finish): rho = sum T_imp /
 sum T_model, each node's share q_i of sum w_i(theta) T_model, normalised by Q = sum q_j^2 so that the
 interpolated scale at the window's temperatures moves by the gain times its error, a node not yet learned
-following the measurement in full: s_i += clip(gain g_i s_i (rho - 1), +-step), g_i = max(q_i / Q, 1 - c_i),
+following the measurement in full: s_i += clip(gain g_i s_i (rho - 1), +-step (1 - c_i / 2)), g_i = max(q_i / Q, 1 - c_i),
 in its band; the confidence c_i += gain_c q_i (1 - c_i) (c_i before the update); the kiss point from the least squares of
 r = T_imp - T_model on the model's Coulomb torque x1 and its Coulomb torque per newton x2; the film factor
 from the early window's ratio rho_e against rho.
@@ -275,7 +275,8 @@ class AdaptationReference:
             band = st.scale_band
             for i in range(NODES):
                 g = max(share[i] / q2, 1.0 - v.confidence[i])
-                step = _clip(st.scale_gain * g * v.friction_scale[i] * (rho - 1.0), -st.scale_step, st.scale_step)
+                limit = st.scale_step * (1.0 - 0.5 * v.confidence[i])     # a confident node moves less per shift
+                step = _clip(st.scale_gain * g * v.friction_scale[i] * (rho - 1.0), -limit, limit)
                 v.friction_scale[i] = _clip(v.friction_scale[i] + step, 1.0 - band, 1.0 + band)
                 v.confidence[i] += st.confidence_gain * share[i] * (1.0 - v.confidence[i])
             # the kiss point: r = b1 x1 + b2 x2, b1 = s - 1, b2 = -s dF

@@ -8,7 +8,10 @@ Per variant (adaptation_runs.py has the runs):
              learned values as the TCU reports them (AdaptationReport, and all nodes from its adaptation file);
              the base plant's sequence is run too, with adaptation (the matched plant) and without (`full`);
   matrix     issue 13's scenario matrix: `adaptive` from the image learned in the first LEARN_SHIFTS shifts
-             (wc_replay --adaptation-file), against `feedback`, `blind` (and `full`, the before);
+             (wc_replay --adaptation-file), against `feedback`, `blind` (and `full`, the before); in the
+             friction -/+10 % scenarios (a clutch that changed by 10 % after it was learned) from that image
+             after LEARN_SHIFTS more shifts of the sequence on the changed plant: the target is "after at
+             most LEARN_SHIFTS shifts" on every plant, and a friction change is one;
   faults     from the same image: one shift with a fault (adaptation_runs.FAULTS), then RECOVERY_SHIFTS good
              shifts, against the same shifts without the fault;
   soak       the matrix's heat soak (10 back-to-back shifts at 80 degC) with and without adaptation.
@@ -31,6 +34,7 @@ Targets (targets(), evaluated on what ran):
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from pathlib import Path
@@ -173,15 +177,32 @@ def run_study(out_dir: Path, variants=None, shifts: int = DEFAULT_SHIFTS, *, con
     return res
 
 
+def _relearned(params, image, sc, work: Path) -> Path:
+    """The image after LEARN_SHIFTS more shifts of the sequence (oil cycle, gaps) on the plant of a friction
+    scenario (the variant's friction times the scenario's), from the variant's learned image."""
+    changed = dataclasses.replace(params, friction_scale=params.friction_scale * sc.friction_scale)
+    seq = runs.learn(changed, "shift_1_2_adaptive", LEARN_SHIFTS, work, image=Path(image),
+                     keep_after=LEARN_SHIFTS)
+    return Path(seq["image_after"])
+
+
 def _matrix(params, controllers, image, work: Path, progress, name) -> dict:
-    """Every controller on every scenario; `adaptive` from the learned image (a copy per scenario)."""
+    """Every controller on every scenario; `adaptive` from the learned image (a copy per scenario), in the
+    friction scenarios from the image relearned on that plant (_relearned)."""
     out = {}
+    relearned = {}
     for ctrl in controllers:
         _say(progress, f"[{name}] matrix: {ctrl}")
         out[ctrl] = {}
         for sc in scenario_matrix():
+            start = image
+            if ctrl == "adaptive" and not math.isclose(sc.friction_scale, 1.0):
+                if sc.name not in relearned:
+                    _say(progress, f"[{name}] relearning {LEARN_SHIFTS} shifts for {sc.name}")
+                    relearned[sc.name] = _relearned(params, image, sc, work / "relearn" / sc.name)
+                start = relearned[sc.name]
             recs = runs.matrix_case(params, f"shift_1_2_{ctrl}", sc, work / ctrl / sc.name,
-                                    image if ctrl == "adaptive" else None)
+                                    start if ctrl == "adaptive" else None)
             es = [runs.shift_entry(i + 1, r) for i, r in enumerate(recs)]
             q = worst([e["quality"] for e in es])
             if sc.shifts > 1:
