@@ -35,13 +35,15 @@ class InprocTcu:
         res = subprocess.run([str(program)], capture_output=True, text=True)
         return "--adaptation-file" in res.stdout + res.stderr
 
-    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
-        lines = "".join(f"({t_s:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n" for m in frames)
+    def _write(self, lines: str) -> None:
         try:
             self.proc.stdin.write(lines)
             self.proc.stdin.flush()
         except BrokenPipeError:
             raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}") from None
+
+    def _read_period(self) -> list[tuple[int, bytes]]:
+        """One period's output frames, up to wc_replay --lockstep's "." line."""
         out = []
         while True:
             line = self.proc.stdout.readline()
@@ -53,6 +55,14 @@ class InprocTcu:
             ident, data = line.split()[2].split("#")
             out.append((int(ident, 16), bytes.fromhex(data)))
 
+    @staticmethod
+    def _lines(t_s: float, frames) -> str:
+        return "".join(f"({t_s:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n" for m in frames)
+
+    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
+        self._write(self._lines(t_s, frames))
+        return self._read_period()
+
     def run_open_loop(self, t_s: float, steps, chunk: int = 200) -> list[tuple[int, bytes]]:
         """Periods whose inputs do not depend on the TCU's outputs (steps: each period's frames), written
         ahead in chunks (no round trip per period; a chunk's input and output stay below a pipe's buffer)
@@ -61,24 +71,9 @@ class InprocTcu:
         last: list[tuple[int, bytes]] = []
         for c0 in range(0, len(steps), chunk):
             part = steps[c0:c0 + chunk]
-            lines = "".join(f"({t_s + (c0 + j) * 1e-3:.6f}) vcan0 {m.arbitration_id:03X}#{bytes(m.data).hex().upper()}\n"
-                            for j, frames in enumerate(part) for m in frames)
-            try:
-                self.proc.stdin.write(lines)
-                self.proc.stdin.flush()
-            except BrokenPipeError:
-                raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}") from None
+            self._write("".join(self._lines(t_s + (c0 + j) * 1e-3, frames) for j, frames in enumerate(part)))
             for _ in part:
-                last = []
-                while True:
-                    line = self.proc.stdout.readline()
-                    if not line:
-                        raise ShiftError(f"wc_replay stopped: {self.proc.stderr.read().strip()}")
-                    line = line.strip()
-                    if line == ".":
-                        break
-                    ident, data = line.split()[2].split("#")
-                    last.append((int(ident, 16), bytes.fromhex(data)))
+                last = self._read_period()
         return last
 
     def close(self):
