@@ -29,36 +29,53 @@ static int write_all(int fd, const uint8_t *buffer, size_t length)
     return 0;
 }
 
+/* A failed write: reported with the step and errno, the temporary removed, the old image kept. */
+static void store_failed(wc_adapt_file_t *file, const char *tmp, const char *step, int error)
+{
+    if (tmp != NULL) { (void)unlink(tmp); }
+    file->failures++;
+    fprintf(stderr, "%s: adaptation image %s not written (%s: %s); the previous image is kept\n", file->program,
+            file->path, step, strerror(error));
+}
+
 /* DESIGN 12: the image written to PATH.tmp, synced, renamed over PATH: a crash
  * or a full disk leaves the old image or the new one, never half of one. */
 static void store(const wc_adapt_t *adapt, void *context)
 {
     wc_adapt_file_t *file = context;
     uint8_t image[WC_ADAPT_IMAGE_BYTES];
-    const size_t length = wc_adapt_image_write(adapt, 0u, image, sizeof image);
     char tmp[4096];
     const int n = snprintf(tmp, sizeof tmp, "%s.tmp", file->path);
-    int fd = -1;
-    const char *step = "path too long";
-    if ((n > 0) && ((size_t)n < sizeof tmp) && (length == sizeof image)) {
-        step = "open";
-        fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if ((fd >= 0) && ((step = "write"), write_all(fd, image, length) == 0) && ((step = "fsync"), fsync(fd) == 0)) {
-            step = "close";
-            const int closed = close(fd);
-            fd = -1;
-            if ((closed == 0) && ((step = "rename"), rename(tmp, file->path) == 0)) {
-                file->writes++;
-                return;
-            }
-        }
+    if ((n <= 0) || ((size_t)n >= sizeof tmp) || (wc_adapt_image_write(adapt, 0u, image, sizeof image) != sizeof image)) {
+        store_failed(file, NULL, "path too long", ENAMETOOLONG);
+        return;
     }
-    const int error = errno;
-    if (fd >= 0) { (void)close(fd); }
-    if ((n > 0) && ((size_t)n < sizeof tmp)) { (void)unlink(tmp); }
-    file->failures++;
-    fprintf(stderr, "%s: adaptation image %s not written (%s: %s); the previous image is kept\n", file->program,
-            file->path, step, strerror(error));
+    const int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) {
+        store_failed(file, NULL, "open", errno);
+        return;
+    }
+    if (write_all(fd, image, sizeof image) != 0) {
+        const int error = errno;
+        (void)close(fd);
+        store_failed(file, tmp, "write", error);
+        return;
+    }
+    if (fsync(fd) != 0) {
+        const int error = errno;
+        (void)close(fd);
+        store_failed(file, tmp, "fsync", error);
+        return;
+    }
+    if (close(fd) != 0) {
+        store_failed(file, tmp, "close", errno);
+        return;
+    }
+    if (rename(tmp, file->path) != 0) {
+        store_failed(file, tmp, "rename", errno);
+        return;
+    }
+    file->writes++;
 }
 
 uint32_t wc_adapt_file_attach(wc_adapt_file_t *file, wc_loop_t *loop)
