@@ -28,11 +28,14 @@ static wc_calibration_t clutch_cal(bool film_on)
     return cal;
 }
 
+/* The adaptation switch of a calibration (the vectors' rules set it on). */
+static void switch_adaptation(wc_shift_calibration_t *cal, uint32_t adaptation) { cal->adaptation = adaptation; }
+
 static wc_shift_calibration_t adapt_cal(uint32_t adaptation)
 {
     wc_shift_calibration_t cal = WC_TEST_SHIFT_CALIBRATION;
-    WC_GOLDEN_ADAPT_CALIBRATION(&cal);
-    if (cal.adaptation != adaptation) { cal.adaptation = adaptation; }  /* the vectors' rules, switched as asked */
+    WC_GOLDEN_ADAPT_CALIBRATION(&cal);  /* the vectors' rules */
+    switch_adaptation(&cal, adaptation);
     return cal;
 }
 
