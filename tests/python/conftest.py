@@ -67,6 +67,22 @@ def _group(item) -> str:
     return "vcan" if vcan else module
 
 
+_NICE_OUTSIDE_VCAN = 10
+_niced = False
+
+
+def pytest_runtest_setup(item):
+    """With the shared vcan guest running (VCAN_SERVER, scripts/test.sh) and two workers, the worker that
+    runs the CPU-bound modules lowers its priority (and its children's: wc_replay, the plants) before its
+    first one, so the emulated guest, which replays the bench logs in real time on the other core, is not
+    starved: the vcan worker is the test command's longest path. The guest is not pytest's child."""
+    global _niced
+    if (not _niced and os.environ.get("VCAN_SERVER") and os.environ.get("PYTEST_XDIST_WORKER")
+            and _group(item) != "vcan"):
+        os.nice(_NICE_OUTSIDE_VCAN)
+        _niced = True
+
+
 def pytest_itemcollected(item):
     """The marks, as each test is collected (pytest-xdist reads xdist_group in a
     pytest_collection_modifyitems that runs before this file's)."""
