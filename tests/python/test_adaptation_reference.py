@@ -195,7 +195,7 @@ BETWEEN_STEPS = int(round(runner.BETWEEN_SHIFTS_S / 1e-3))
 
 
 def _between(ref, params, scenario):
-    """The periods run_case runs between two shifts (runner._between_shifts: no request, no slip, the oil
+    """The periods run_case runs between two shifts (runner.between_shifts: no request, no slip, the oil
     and housing temperatures), as the TCU decoded them: the reference goes through them too."""
     enc = canlog.Encoder()
     msg = enc.db.get_message_by_name(canlog.SENSORS)

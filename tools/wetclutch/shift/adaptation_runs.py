@@ -12,7 +12,7 @@ matrix_case one scenario of issue 13's matrix (its shifts as run_case runs them:
 The idle gap. A shift ends locked in 2nd gear; the next starts from steady 1st gear with 851 rpm of slip (a
 fresh plant). For the TCU the gap is gap_s of the request withdrawn (ShiftRequest 0) at zero slip (the
 clutch released while synchronised, as in the 2->1 downshift that would come between: runner.
-_between_shifts), the oil and housing temperatures of the next shift; the plant's pack relaxes exactly (eq.
+between_shifts), the oil and housing temperatures of the next shift; the plant's pack relaxes exactly (eq.
 1, no friction power) towards the same. The study's gap (STUDY_GAP_S, 4.4 pack time constants) lets the
 pack follow the oil cycle: each shift starts within 0.6 K of its oil's steady state. The gap's frames do
 not depend on the TCU's answers: they are written ahead (InprocTcu.run_open_loop), 8 s cost 0.06 s of CPU.
@@ -20,7 +20,6 @@ not depend on the TCU's answers: they are written ahead (InprocTcu.run_open_loop
 from __future__ import annotations
 
 import functools
-import math
 import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,7 +30,7 @@ from ..calibration import adaptation_image
 from ..calibration import shift as shift_calibration
 from ..util import canlog
 from .quality import quality
-from .runner import BETWEEN_SHIFTS_S, _one_shift
+from .runner import BETWEEN_SHIFTS_S, _one_shift, between_shifts
 from .scenarios import SHIFT_TOML, TARGET_INERTIA_S, Scenario
 from .tcu import InprocTcu
 
@@ -146,10 +145,6 @@ class Session:
         self.db = self.enc.db
         self.t_s = 0.0
         self.theta_degC = None           # the plant's pack at the next shift's start (None: the oil's)
-        self._idle_cache: dict = {}
-        c = params.clutch_cal
-        self.k12 = c.oil_conductance + c.housing_conductance
-        self.tau_s = c.heat_capacity / self.k12
 
     def close(self):
         self.tcu.close()
@@ -178,50 +173,12 @@ class Session:
         rec["values"] = self.values()
         return rec
 
-    def _idle_frames(self, oil_degC: float, housing_degC: float) -> dict:
-        """The gap's frames for each alive counter (their signals do not change): {name: [16 messages]}."""
-        key = (round(oil_degC, 1), round(housing_degC, 1))
-        if key not in self._idle_cache:
-            out = {}
-            for name, sig in ((canlog.REQUEST, {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT}),
-                              (canlog.SHIFT_COMMAND, {"ShiftRequest": 0, "AdaptationReset": 0, "TargetGear": 2,
-                                                      "TurbineTorque": 0.0, "TargetInertiaTime": round(self.target_s * 1e3)}),
-                              (canlog.SENSORS, {"SlipSpeed": 0.0, "OilTemp": key[0], "HousingTemp": key[1]})):
-                msg = self.db.get_message_by_name(name)
-                sig = {k: v for k, v in sig.items() if k in {s.name for s in msg.signals}}
-                frames = []
-                for count in range(16):
-                    data = bytearray(msg.encode({"Crc": 0, "AliveCounter": count, **sig}, scaling=True, strict=True))
-                    canlog.protect(msg.frame_id, data)
-                    frames.append(canlog.can.Message(arbitration_id=msg.frame_id, is_extended_id=False, data=bytes(data)))
-                out[name] = frames
-            self._idle_cache[key] = out
-        return self._idle_cache[key]
-
     def idle(self, gap_s: float, oil_degC: float) -> None:
-        """The gap before the next shift (module docstring): the TCU at zero slip with the request withdrawn
-        for gap_s, the plant's pack relaxed exactly towards the steady state of the next oil temperature."""
-        n = int(round(gap_s / 1e-3))
-        if n <= 0:
-            return
-        housing = oil_degC + self.params.housing_offset
-        frames = self._idle_frames(oil_degC, housing)
-        counters = self.enc.counters
-        names = (canlog.REQUEST, canlog.SHIFT_COMMAND, canlog.SENSORS)
-        steps = []
-        for _ in range(n):
-            batch = []
-            for name in names:
-                c = counters.get(name, 0)
-                batch.append(frames[name][c])
-                counters[name] = (c + 1) % 16
-            steps.append(batch)
-        self.tcu.run_open_loop(self.t_s, steps)
-        self.t_s += n * 1e-3
-        c = self.params.clutch_cal
-        steady = (c.oil_conductance * oil_degC + c.housing_conductance * housing) / self.k12
-        if self.theta_degC is not None:
-            self.theta_degC = steady + (self.theta_degC - steady) * math.exp(-gap_s / self.tau_s)
+        """The gap before the next shift (module docstring; runner.between_shifts): the TCU at zero slip with
+        the request withdrawn for gap_s, the plant's pack relaxed towards the next oil temperature's steady
+        state."""
+        self.theta_degC, self.t_s = between_shifts(self.params, self.tcu, self.enc, oil_degC, self.theta_degC,
+                                                   self.t_s, gap_s, self.target_s)
 
 
 # --------------------------------------------------------------------------------------------------- runs

@@ -2,6 +2,7 @@
 reference on the TCU's inputs (reference_run), and the case on vcan (run_on_vcan)."""
 from __future__ import annotations
 
+import functools
 import json
 import os
 import subprocess
@@ -128,32 +129,65 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     return rec
 
 
-BETWEEN_SHIFTS_S = 0.5   # back-to-back shifts: the 2->1 downshift's release between them (see _between_shifts)
+BETWEEN_SHIFTS_S = 0.5   # back-to-back shifts: the 2->1 downshift's release between them (see between_shifts)
+IDLE_FRAMES = (canlog.REQUEST, canlog.SHIFT_COMMAND, canlog.SENSORS)
 
 
-def _between_shifts(params, tcu, enc, scenario: Scenario, theta_clutch_degC: float, t0_s: float) -> tuple[float, float]:
-    """The time between two back-to-back shifts, where a vehicle's 2->1 downshift releases the on-coming
-    clutch: BETWEEN_SHIFTS_S of frames with ShiftRequest 0 and no slip (the released clutch in 2nd gear,
-    before 1st gear's slip builds up), so the TCU's VFS and film release the clutch without slip (no model
-    heat); the plant's pack cools with eq. 1 and no friction power over the same time. Without it the next
-    shift's plant starts in 1st gear at full slip while the TCU's model still holds the clutch locked,
-    and the observer takes tens of kW of drag heat that no real clutch sees (about +12 K per shift).
-    Returns the pack temperature after it and the time."""
-    cal = params.clutch_cal
+@functools.lru_cache(maxsize=32)
+def _idle_frames(oil_degC: float, housing_degC: float, target_ms: int) -> dict:
+    """The idle period's frames for each alive counter (their signals do not change): {name: [16 messages]}."""
+    db = canlog.database()
+    out = {}
+    for name, sig in ((canlog.REQUEST, {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT}),
+                      (canlog.SHIFT_COMMAND, {"ShiftRequest": 0, "AdaptationReset": 0, "TargetGear": 2,
+                                              "TurbineTorque": 0.0, "TargetInertiaTime": target_ms}),
+                      (canlog.SENSORS, {"SlipSpeed": 0.0, "OilTemp": oil_degC, "HousingTemp": housing_degC})):
+        msg = db.get_message_by_name(name)
+        frames = []
+        for count in range(16):
+            data = bytearray(msg.encode({"Crc": 0, "AliveCounter": count, **sig}, scaling=True, strict=True))
+            canlog.protect(msg.frame_id, data)
+            frames.append(canlog.can.Message(arbitration_id=msg.frame_id, is_extended_id=False, data=bytes(data)))
+        out[name] = frames
+    return out
+
+
+def between_shifts(params, tcu, enc, oil_degC: float, theta_clutch_degC: float | None, t0_s: float,
+                   gap_s: float = BETWEEN_SHIFTS_S, target_s: float = TARGET_INERTIA_S) -> tuple[float | None, float]:
+    """The time between two shifts, where a vehicle's 2->1 downshift releases the on-coming clutch: gap_s
+    of frames with ShiftRequest 0 and no slip (the released clutch in 2nd gear, before 1st gear's slip
+    builds up), so the TCU's VFS and film release the clutch without slip (no model heat); the plant's pack
+    relaxes with eq. 1 and no friction power over the same time, towards the steady state of oil_degC.
+    Without it the next shift's plant starts in 1st gear at full slip while the TCU's model still holds the
+    clutch locked, and the observer takes tens of kW of drag heat that no real clutch sees (about +12 K per
+    shift). The frames go out written ahead where the TCU can take them so (InprocTcu.run_open_loop), else
+    one period at a time. Returns the pack temperature after it (None stays None: the oil's) and the time."""
     dt = 1e-3
-    n = int(round(BETWEEN_SHIFTS_S / dt))
-    oil = scenario.oil_degC
-    housing = oil + params.housing_offset
-    for k in range(n):
-        frames = [enc.frame(canlog.REQUEST, TorqueRequest=0.0, Mode=canlog.MODE_SHIFT),
-                  enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=0, AdaptationReset=0, TargetGear=2, TurbineTorque=0.0,
-                            TargetInertiaTime=round(TARGET_INERTIA_S * 1e3)),
-                  enc.frame(canlog.SENSORS, SlipSpeed=0.0, OilTemp=oil, HousingTemp=housing)]
-        tcu.exchange(t0_s + k * dt, frames)
-    k_total = cal.oil_conductance + cal.housing_conductance
-    steady = (cal.oil_conductance * oil + cal.housing_conductance * housing) / k_total      # eq. 1, no friction power
-    theta = steady + (theta_clutch_degC - steady) * np.exp(-k_total * n * dt / cal.heat_capacity)
-    return float(theta), t0_s + n * dt
+    n = int(round(gap_s / dt))
+    if n <= 0:
+        return theta_clutch_degC, t0_s
+    housing = oil_degC + params.housing_offset
+    frames = _idle_frames(round(oil_degC, 1), round(housing, 1), round(target_s * 1e3))
+    steps = []
+    for _ in range(n):
+        batch = []
+        for name in IDLE_FRAMES:
+            count = enc.counters.get(name, 0)
+            batch.append(frames[name][count])
+            enc.counters[name] = (count + 1) % 16      # as Encoder.frame counts
+        steps.append(batch)
+    if hasattr(tcu, "run_open_loop"):
+        tcu.run_open_loop(t0_s, steps)
+    else:
+        for k, batch in enumerate(steps):
+            tcu.exchange(t0_s + k * dt, batch)
+    theta = theta_clutch_degC
+    if theta is not None:
+        cal = params.clutch_cal
+        k_total = cal.oil_conductance + cal.housing_conductance
+        steady = (cal.oil_conductance * oil_degC + cal.housing_conductance * housing) / k_total  # eq. 1, no power
+        theta = float(steady + (theta - steady) * np.exp(-k_total * n * dt / cal.heat_capacity))
+    return theta, t0_s + n * dt
 
 
 def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None = None, tcu=None,
@@ -171,7 +205,7 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
         records = []
         for i in range(scenario.shifts):
             if i > 0:
-                theta, t0 = _between_shifts(params, tcu, enc, scenario, theta, t0)
+                theta, t0 = between_shifts(params, tcu, enc, scenario.oil_degC, theta, t0, target_s=target_s)
             rec = _one_shift(params, tcu, enc, db, scenario, theta, t0, params.seed + i, target_s, shift_cal)
             records.append(rec)
             theta = rec["end_theta_degC"]
