@@ -160,6 +160,11 @@ typedef struct {
 /* The calibration's values (defaults); status unchanged. */
 void wc_adapt_reset(wc_adapt_t *adapt);
 
+/* A reset by command (DBC ShiftCommand.AdaptationReset): the calibration's
+ * values and WC_ADAPT_STATUS_RESET; returns what to report (result OFF, the
+ * defaults). NULL: WC_ASSERT, the report only. */
+wc_adapt_change_t wc_adapt_command_reset(wc_adapt_t *adapt);
+
 /* Values inside the bands of cal (finite, confidences in [0, 1]): true. */
 bool wc_adapt_values_valid(const wc_adapt_values_t *values, const struct wc_shift_calibration *cal);
 

@@ -392,10 +392,7 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     const bool reset = (loop->config.shift != NULL) && (loop->config.shift->adaptation == 1u) && shift_mode &&
                        (loop->shift_command.adaptation_reset > 0.5f);
     if (reset && !loop->last_adaptation_reset && !shift_running && !safe) {
-        wc_adapt_reset(&loop->adapt);
-        loop->adapt.status |= WC_ADAPT_STATUS_RESET;
-        const wc_adapt_change_t none = { (uint32_t)WC_ADAPT_RESULT_OFF, 0u, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f };
-        loop->report.adaptation = none;
+        loop->report.adaptation = wc_adapt_command_reset(&loop->adapt);
         step |= STEP_ADAPT;
     }
     loop->last_adaptation_reset = reset;

@@ -11,6 +11,9 @@ static float clip(float value, float lo, float hi)
     return (value > lo) ? ((value < hi) ? value : hi) : lo;  /* NaN -> lo */
 }
 
+/* What a shift that changed nothing reports (also: adaptation off, a reset): the defaults of node 0. */
+static const wc_adapt_change_t unchanged = { (uint32_t)WC_ADAPT_RESULT_OFF, 0u, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f };
+
 void wc_adapt_reset(wc_adapt_t *adapt)
 {
     WC_ASSERT(adapt != NULL);
@@ -23,6 +26,16 @@ void wc_adapt_reset(wc_adapt_t *adapt)
     adapt->values.kiss_offset_Pa = 0.0f;
     adapt->values.shifts_learned = 0u;
     wc_adapt_begin(adapt);
+}
+
+wc_adapt_change_t wc_adapt_command_reset(wc_adapt_t *adapt)
+{
+    WC_ASSERT(adapt != NULL);
+    if (adapt != NULL) {
+        wc_adapt_reset(adapt);
+        adapt->status |= WC_ADAPT_STATUS_RESET;
+    }
+    return unchanged;
 }
 
 static bool within(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
@@ -170,7 +183,7 @@ static float kiss_innovation_Pa(const wc_adapt_window_t *w, const wc_shift_calib
 wc_adapt_change_t wc_adapt_finish(wc_adapt_t *adapt, const wc_shift_calibration_t *cal, uint32_t abort_reason,
                                   const wc_clutch_t *clutch)
 {
-    wc_adapt_change_t change = { (uint32_t)WC_ADAPT_RESULT_OFF, 0u, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f };
+    wc_adapt_change_t change = unchanged;
     if (!adaptation_on(adapt, cal) || (clutch == NULL) || (clutch->model.cal == NULL)) { return change; }
     wc_adapt_values_t *v = &adapt->values;
     const wc_adapt_window_t *w = &adapt->window;

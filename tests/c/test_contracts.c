@@ -113,6 +113,7 @@ static void test_adaptation_contracts(void **state)
     wc_adapt_t adapt;
     uint8_t image[WC_ADAPT_IMAGE_BYTES];
     expect_assert_failure(wc_adapt_reset(NULL));
+    expect_assert_failure(wc_adapt_command_reset(NULL));
     expect_assert_failure(wc_adapt_image_load(NULL, &cal, 0u, image, sizeof image));
     expect_assert_failure(wc_adapt_image_load(&adapt, NULL, 0u, image, sizeof image));
     expect_assert_failure(wc_adapt_image_write(NULL, 0u, image, sizeof image));
