@@ -54,6 +54,8 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_FRAME_ID (0x122u)
 #define WC_CAN_ADAPTATION_REPORT_FRAME_ID (0x123u)
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
+#define WC_CAN_XCP_COMMAND_FRAME_ID (0x7f0u)
+#define WC_CAN_XCP_RESPONSE_FRAME_ID (0x7f1u)
 
 /* Frame lengths in bytes. */
 #define WC_CAN_CLUTCH_SENSORS_LENGTH (8u)
@@ -64,6 +66,8 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_LENGTH (8u)
 #define WC_CAN_ADAPTATION_REPORT_LENGTH (8u)
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
+#define WC_CAN_XCP_COMMAND_LENGTH (8u)
+#define WC_CAN_XCP_RESPONSE_LENGTH (8u)
 
 /* Extended or standard frame types. */
 #define WC_CAN_CLUTCH_SENSORS_IS_EXTENDED (0)
@@ -74,6 +78,8 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_IS_EXTENDED (0)
 #define WC_CAN_ADAPTATION_REPORT_IS_EXTENDED (0)
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
+#define WC_CAN_XCP_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_XCP_RESPONSE_IS_EXTENDED (0)
 
 /* Frame cycle times in milliseconds. */
 #define WC_CAN_CLUTCH_SENSORS_CYCLE_TIME_MS (1u)
@@ -139,6 +145,8 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_NAME "ShiftReport"
 #define WC_CAN_ADAPTATION_REPORT_NAME "AdaptationReport"
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
+#define WC_CAN_XCP_COMMAND_NAME "XcpCommand"
+#define WC_CAN_XCP_RESPONSE_NAME "XcpResponse"
 
 /* Signal Names. */
 #define WC_CAN_CLUTCH_SENSORS_CRC_NAME "Crc"
@@ -201,6 +209,8 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_NAME "LoadCellForce"
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_NAME "MeasuredTorque"
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
+#define WC_CAN_XCP_COMMAND_XCP_COMMAND_PID_NAME "XcpCommandPid"
+#define WC_CAN_XCP_RESPONSE_XCP_RESPONSE_PID_NAME "XcpResponsePid"
 
 /**
  * Signals in message ClutchSensors.
@@ -812,6 +822,42 @@ struct wc_can_bench_measurement_t {
      * Offset: -50
      */
     uint16_t clutch_thermistor_temp;
+};
+
+/**
+ * Signals in message XcpCommand.
+ *
+ * XCP on CAN (ASAM MCD-1 XCP, CAN transport layer), master to slave: command transfer objects (CTO), byte 0 the command code (PID), DLC 1..8. Not E2E protected (XCP has its own command/response protocol); not used for control. The lowest-priority ids of the database, so that XCP traffic never wins arbitration over a control frame (src/can/wc_xcp.h).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_xcp_command_t {
+    /**
+     * XCP command code (0xFF CONNECT ... 0xC0 transport-layer commands); the rest of the frame is the command's parameters.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t xcp_command_pid;
+};
+
+/**
+ * Signals in message XcpResponse.
+ *
+ * XCP on CAN, slave to master: responses (PID 0xFF), errors (0xFE), events (0xFD) and DAQ data transfer objects (PID = absolute ODT number), DLC 8 (padded with 0). Sent by the TCU after the step's VfsCommand, never instead of it (src/can/wc_xcp.h). Not E2E protected.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_xcp_response_t {
+    /**
+     * XCP packet identifier: 0xFF positive response, 0xFE error, 0xFD event, 0x00..0xFB DAQ (absolute ODT number).
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t xcp_response_pid;
 };
 
 /**
@@ -2429,6 +2475,124 @@ bool wc_can_bench_measurement_clutch_thermistor_temp_is_in_range(uint16_t value)
  * @return true if in range, false otherwise.
  */
 bool wc_can_bench_measurement_clutch_thermistor_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message XcpCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_xcp_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_xcp_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message XcpCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_xcp_command_unpack(
+    struct wc_can_xcp_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from XcpCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_xcp_command_init(struct wc_can_xcp_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_xcp_command_xcp_command_pid_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_xcp_command_xcp_command_pid_is_in_phys_range(float value);
+
+/**
+ * Pack message XcpResponse.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_xcp_response_pack(
+    uint8_t *dst_p,
+    const struct wc_can_xcp_response_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message XcpResponse.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_xcp_response_unpack(
+    struct wc_can_xcp_response_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from XcpResponse.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_xcp_response_init(struct wc_can_xcp_response_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_xcp_response_xcp_response_pid_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_xcp_response_xcp_response_pid_is_in_phys_range(float value);
 
 
 #ifdef __cplusplus

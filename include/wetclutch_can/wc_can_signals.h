@@ -69,6 +69,8 @@ extern const wc_can_signal_t wc_can_sig_adaptation_report_kiss_offset; /* kPa */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force; /* N */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_xcp_command_xcp_command_pid; /* 1 */
+extern const wc_can_signal_t wc_can_sig_xcp_response_xcp_response_pid; /* 1 */
 
 /** ClutchSensors (0x110) in physical units. */
 typedef struct {
@@ -144,6 +146,16 @@ typedef struct {
     float clutch_thermistor_temp_degC;
 } wc_can_bench_measurement_phys_t;
 
+/** XcpCommand (0x7F0) in physical units. */
+typedef struct {
+    float xcp_command_pid;
+} wc_can_xcp_command_phys_t;
+
+/** XcpResponse (0x7F1) in physical units. */
+typedef struct {
+    float xcp_response_pid;
+} wc_can_xcp_response_phys_t;
+
 /* Encode: converts every signal, packs dst[0..7] (unused bits 0) and, for
  * E2E frames, writes the CRC. Decode: WC_CAN_ERR_SIZE / WC_CAN_ERR_CRC leave
  * *dst untouched; otherwise every field is written and the worst signal
@@ -164,6 +176,10 @@ wc_can_result_t wc_can_encode_adaptation_report(uint8_t *dst, const wc_can_adapt
 wc_can_result_t wc_can_decode_adaptation_report(wc_can_adaptation_report_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_xcp_command(uint8_t *dst, const wc_can_xcp_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_xcp_command(wc_can_xcp_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_xcp_response(uint8_t *dst, const wc_can_xcp_response_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_xcp_response(wc_can_xcp_response_phys_t *dst, const uint8_t *src, size_t size);
 
 #ifdef __cplusplus
 }

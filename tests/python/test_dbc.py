@@ -39,6 +39,9 @@ FRAMES = {
     "ShiftReport": (0x122, "TCU", {"VCU"}, None, False),   # sent once per shift, not cyclic
     "AdaptationReport": (0x123, "TCU", {"VCU"}, None, False),   # with ShiftReport when adaptation is on (DESIGN 12)
     "BenchMeasurement": (0x130, "BENCH", {"TCU"}, 1, False),
+    # XCP on CAN (DESIGN 13): event-driven command/response, not E2E, the lowest priority on the bus
+    "XcpCommand": (0x7F0, "TOOL", {"TCU"}, None, False),
+    "XcpResponse": (0x7F1, "TCU", {"TOOL"}, None, False),
 }
 # Layout constants of src/can/wc_e2e.h.
 E2E_CRC_START, E2E_CRC_LEN = 0, 8
@@ -52,7 +55,7 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
     "StatusFrameLost", "StatusBusError", "StatusLocked",
 ]
 # Integer signals that the scaling wrapper does not convert.
-UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", *STATUS_BITS}
+UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", "XcpCommandPid", "XcpResponsePid", *STATUS_BITS}
 
 
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
@@ -76,7 +79,7 @@ def db():
 
 def test_loads_strictly_without_warnings(db):
     assert {m.name for m in db.messages} == set(FRAMES)
-    assert {n.name for n in db.nodes} == {"TCU", "VCU", "BENCH"}
+    assert {n.name for n in db.nodes} == {"TCU", "VCU", "BENCH", "TOOL"}
 
 
 def test_cantools_dump_is_clean():

@@ -1249,3 +1249,105 @@ bool wc_can_bench_measurement_clutch_thermistor_temp_is_in_phys_range(float valu
 {
     return ((value >= -40.0f) && (value <= 350.0f));
 }
+
+int wc_can_xcp_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_xcp_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->xcp_command_pid, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_xcp_command_unpack(
+    struct wc_can_xcp_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->xcp_command_pid = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_xcp_command_init(struct wc_can_xcp_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_xcp_command_t));
+
+    return 0;
+}
+
+bool wc_can_xcp_command_xcp_command_pid_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_xcp_command_xcp_command_pid_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+int wc_can_xcp_response_pack(
+    uint8_t *dst_p,
+    const struct wc_can_xcp_response_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->xcp_response_pid, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_xcp_response_unpack(
+    struct wc_can_xcp_response_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->xcp_response_pid = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_xcp_response_init(struct wc_can_xcp_response_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_xcp_response_t));
+
+    return 0;
+}
+
+bool wc_can_xcp_response_xcp_response_pid_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_xcp_response_xcp_response_pid_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}

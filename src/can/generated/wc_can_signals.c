@@ -142,6 +142,14 @@ const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp = {
     .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
     .raw_nan = (int32_t)WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_SNA_CHOICE, .has_sna = true,
 };
+const wc_can_signal_t wc_can_sig_xcp_command_xcp_command_pid = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_xcp_response_xcp_response_pid = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
 
 /* ---- frames ---- */
 
@@ -521,5 +529,69 @@ wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t 
     dst->load_cell_force_N = to_phys(&wc_can_sig_bench_measurement_load_cell_force, msg.load_cell_force, &result);
     dst->measured_torque_Nm = to_phys(&wc_can_sig_bench_measurement_measured_torque, msg.measured_torque, &result);
     dst->clutch_thermistor_temp_degC = to_phys(&wc_can_sig_bench_measurement_clutch_thermistor_temp, msg.clutch_thermistor_temp, &result);
+    return result;
+}
+
+/* XcpCommand */
+
+wc_can_result_t wc_can_encode_xcp_command(uint8_t *dst, const wc_can_xcp_command_phys_t *src, size_t size)
+{
+    struct wc_can_xcp_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_XCP_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.xcp_command_pid = (uint8_t)to_raw(&wc_can_sig_xcp_command_xcp_command_pid, src->xcp_command_pid, &result);
+    if (wc_can_xcp_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_xcp_command(wc_can_xcp_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_xcp_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_XCP_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_xcp_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->xcp_command_pid = to_phys(&wc_can_sig_xcp_command_xcp_command_pid, msg.xcp_command_pid, &result);
+    return result;
+}
+
+/* XcpResponse */
+
+wc_can_result_t wc_can_encode_xcp_response(uint8_t *dst, const wc_can_xcp_response_phys_t *src, size_t size)
+{
+    struct wc_can_xcp_response_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_XCP_RESPONSE_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.xcp_response_pid = (uint8_t)to_raw(&wc_can_sig_xcp_response_xcp_response_pid, src->xcp_response_pid, &result);
+    if (wc_can_xcp_response_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_xcp_response(wc_can_xcp_response_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_xcp_response_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_XCP_RESPONSE_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_xcp_response_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->xcp_response_pid = to_phys(&wc_can_sig_xcp_response_xcp_response_pid, msg.xcp_response_pid, &result);
     return result;
 }
