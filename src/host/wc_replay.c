@@ -2,6 +2,12 @@
  *
  *   wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC]
  *             [--shift NAME [--set FIELD=VALUE]...] [--lockstep]
+ *   wc_replay LOG [--bench] --calibration-image FILE [--theta-start DEGC] [--lockstep]
+ *
+ * --calibration-image: the whole calibration (clutch, shift control, loop
+ * timeouts and E2E) from an image file (wc_cal_image.h, `wetclutch
+ * cal-image`), as wc_tcu --calibration-image; a refused image: one line,
+ * exit 2. Not with --calibration, --shift or --set.
  *
  * LOG "-" reads standard input. --shift turns shift control on with a
  * compiled-in shift calibration (as wc_tcu --shift); --set overrides one of
@@ -28,6 +34,7 @@
 #include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
 #include "wc_adapt_file.h"
+#include "wc_cal_image_file.h"
 #include "wc_tcu_calibrations.h"
 
 static int parse_line(const char *line, double *t_s, wc_can_frame_t *frame)
@@ -100,7 +107,9 @@ static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
 }
 
 #define USAGE "usage: wc_replay LOG|- [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]" \
-              " [--shift NAME [--set FIELD=VALUE]... [--adaptation-file FILE]] [--lockstep]\n"
+              " [--shift NAME [--set FIELD=VALUE]... [--adaptation-file FILE]] [--lockstep]\n" \
+              "       wc_replay LOG|- [--bench] --calibration-image FILE [--theta-start DEGC] [--adaptation-file FILE]" \
+              " [--lockstep]\n"
 
 int main(int argc, char **argv)
 {
@@ -110,6 +119,8 @@ int main(int argc, char **argv)
     int lockstep = 0;
     const char *log_path = NULL;
     const char *calibration = "table1";
+    const char *image_path = NULL;  /* --calibration-image */
+    int calibration_given = 0;
     int bench = 0;
     double theta_start_degC = 40.0;  /* as wc_tcu --theta-start */
     for (int i = 1; i < argc; ++i) {
@@ -131,10 +142,14 @@ int main(int argc, char **argv)
                 return 2;
             }
         }
-        else if ((strcmp(argv[i], "--adaptation-file") == 0) && (i + 1 < argc) && (shift_name != NULL)) {
+        else if ((strcmp(argv[i], "--adaptation-file") == 0) && (i + 1 < argc) &&
+                 ((shift_name != NULL) || (image_path != NULL))) {
             adaptation_path = argv[++i];
         }
-        else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; }
+        else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; calibration_given = 1; }
+        else if ((strcmp(argv[i], "--calibration-image") == 0) && (i + 1 < argc) && (image_path == NULL)) {
+            image_path = argv[++i];
+        }
         else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
                  ((void)(theta_start_degC = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0')) &&
                  (theta_start_degC >= -40.0) && (theta_start_degC <= 250.0)) { ++i; }
@@ -148,8 +163,25 @@ int main(int argc, char **argv)
         fprintf(stderr, USAGE);
         return 2;
     }
+    static wc_cal_set_t image;  /* --calibration-image: the loop keeps pointers into it */
     const wc_calibration_t *cal = NULL;
-    for (size_t i = 0; i < wc_tcu_calibration_count; ++i) {
+    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    if (image_path != NULL) {
+        if (calibration_given || (shift_name != NULL)) {
+            fprintf(stderr, "wc_replay: --calibration-image holds the whole calibration: not with --calibration,"
+                            " --shift or --set\n");
+            return 2;
+        }
+        if (wc_cal_image_file_load(image_path, "wc_replay", &image) != 0) { return 2; }
+        cal = &image.clutch;
+        config = image.loop;
+        calibration = image_path;
+        if ((adaptation_path != NULL) && (config.shift == NULL)) {
+            fprintf(stderr, "wc_replay: --adaptation-file needs shift control (the image has it off)\n");
+            return 2;
+        }
+    }
+    for (size_t i = 0; (cal == NULL) && (i < wc_tcu_calibration_count); ++i) {
         if (strcmp(calibration, wc_tcu_calibrations[i].name) == 0) { cal = wc_tcu_calibrations[i].calibration; }
     }
     if (cal == NULL) {
@@ -157,7 +189,6 @@ int main(int argc, char **argv)
         return 2;
     }
     static wc_loop_t loop;  /* large (receive ring): static storage */
-    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     config.bench_input_enabled = bench != 0;
     if (shift_name != NULL) {
         const wc_shift_cal_error_t shift_error = wc_shift_calibration_check(&shift);

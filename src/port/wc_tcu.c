@@ -27,6 +27,7 @@
 #include "wetclutch_can/wc_loop.h"
 #include "wc_socketcan.h"
 #include "wc_adapt_file.h"
+#include "wc_cal_image_file.h"
 #include "wc_tcu_calibrations.h"
 
 /* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
@@ -44,6 +45,8 @@ typedef struct {
     const char *calibration;
     const char *shift;        /* --shift NAME: shift control on (NULL: off) */
     const char *adaptation_file;  /* --adaptation-file FILE: the learned values' image (DESIGN 12) */
+    const char *calibration_image;  /* --calibration-image FILE: the whole calibration (wc_cal_image.h) */
+    int compiled_in_given;    /* --calibration, --shift, --sensor-timeout or --request-timeout given */
     const char *stats_json;
     int64_t period_ns;
     int frame_clock;
@@ -101,6 +104,9 @@ static void usage(FILE *out)
             "  -k, --calibration NAME    compiled-in calibration (default table1; --help lists them)\n"
             "  -s, --shift NAME          shift control (TorqueRequest Mode 3, ShiftCommand) with this compiled-in\n"
             "                            shift calibration (--help lists them); default off\n"
+            "      --calibration-image FILE  the whole calibration (clutch, shift control, loop timeouts and E2E)\n"
+            "                            from an image file (`wetclutch cal-image`); a refused image: one line, exit 2;\n"
+            "                            not with --calibration, --shift, --sensor-timeout, --request-timeout\n"
             "      --adaptation-file FILE  with --shift: the clutch's learned values (DESIGN 12), read at start\n"
             "                            (missing or invalid: the calibration's values) and written atomically\n"
             "                            whenever a shift changes them\n"
@@ -139,6 +145,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
         {"bench", no_argument, NULL, 'b'},            {"realtime", no_argument, NULL, 3},
         {"shift", required_argument, NULL, 's'},       {"adaptation-file", required_argument, NULL, 4},
+        {"calibration-image", required_argument, NULL, 5},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
@@ -153,17 +160,18 @@ static int parse_options(int argc, char **argv, options_t *o)
             else { fprintf(stderr, "wc_tcu: --clock: '%s': use timer or frame\n", optarg); return -1; }
             break;
         case 'p': if (parse_number(optarg, "--period-us", 50, 1e6, &v)) { return -1; } o->period_ns = (int64_t)(v * 1000.0); break;
-        case 'k': o->calibration = optarg; break;
-        case 's': o->shift = optarg; break;
+        case 'k': o->calibration = optarg; o->compiled_in_given = 1; break;
+        case 's': o->shift = optarg; o->compiled_in_given = 1; break;
         case 4: o->adaptation_file = optarg; break;
+        case 5: o->calibration_image = optarg; break;
         case 'n': if (parse_number(optarg, "--steps", 1, 1e12, &v)) { return -1; } o->max_steps = (uint64_t)v; break;
         case 'I': if (parse_number(optarg, "--idle-exit", 0.001, 1e6, &v)) { return -1; } o->idle_exit_s = v; break;
         case 't': if (parse_number(optarg, "--theta-start", -40, 250, &v)) { return -1; } o->theta_start_degC = v; break;
         case 'j': o->stats_json = optarg; break;
         case 'b': o->bench = 1; break;
         case 3: o->realtime = 1; break;
-        case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; break;
-        case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; break;
+        case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; o->compiled_in_given = 1; break;
+        case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 'h':
             usage(stdout);
             printf("calibrations:");
@@ -176,6 +184,11 @@ static int parse_options(int argc, char **argv, options_t *o)
         }
     }
     if (optind < argc) { fprintf(stderr, "wc_tcu: unexpected argument '%s'\n", argv[optind]); return -1; }
+    if ((o->calibration_image != NULL) && o->compiled_in_given) {
+        fprintf(stderr, "wc_tcu: --calibration-image holds the whole calibration: not with --calibration, --shift,"
+                        " --sensor-timeout or --request-timeout\n");
+        return -1;
+    }
     return 0;
 }
 
@@ -370,21 +383,31 @@ int main(int argc, char **argv)
 {
     options_t opt;
     if (parse_options(argc, argv, &opt) != 0) { return 2; }
-    const wc_calibration_t *cal = find_calibration(opt.calibration);
-    if (cal == NULL) { return 2; }
     static wc_loop_t loop;  /* large (receive ring): static storage, not the stack */
     static step_times_t times;
+    static wc_cal_set_t image;  /* --calibration-image: the loop keeps pointers into it */
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
-    config.sensor_timeout_periods = opt.sensor_timeout;
-    config.request_timeout_periods = opt.request_timeout;
-    config.bench_input_enabled = opt.bench != 0;
-    if (opt.shift != NULL) {
-        config.shift = wc_tcu_find_shift_calibration(opt.shift);
-        if (config.shift == NULL) {
-            fprintf(stderr, "wc_tcu: --shift: '%s' is not compiled in (wc_tcu --help lists them)\n", opt.shift);
-            return 2;
+    const wc_calibration_t *cal = NULL;
+    if (opt.calibration_image != NULL) {  /* the whole calibration from the image, or not started */
+        if (wc_cal_image_file_load(opt.calibration_image, "wc_tcu", &image) != 0) { return 2; }
+        cal = &image.clutch;
+        config = image.loop;
+        opt.calibration = opt.calibration_image;
+        opt.shift = image.shift_enabled ? "(image)" : NULL;
+    } else {
+        cal = find_calibration(opt.calibration);
+        if (cal == NULL) { return 2; }
+        config.sensor_timeout_periods = opt.sensor_timeout;
+        config.request_timeout_periods = opt.request_timeout;
+        if (opt.shift != NULL) {
+            config.shift = wc_tcu_find_shift_calibration(opt.shift);
+            if (config.shift == NULL) {
+                fprintf(stderr, "wc_tcu: --shift: '%s' is not compiled in (wc_tcu --help lists them)\n", opt.shift);
+                return 2;
+            }
         }
     }
+    config.bench_input_enabled = opt.bench != 0;
     const wc_cal_error_t cal_error = wc_loop_init(&loop, cal, &config, (float)opt.theta_start_degC);
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));
