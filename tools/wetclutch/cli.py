@@ -2,6 +2,7 @@
 
 commands by role (the folder of tools/wetclutch that does the work):
   generate/   lut         calibration and h_bar(p_c) headers (a shift calibration: its header)
+              cal-image   the calibration image (clutch, shift, loop) for --calibration-image, or its C header
               vectors     golden vectors for the C tests
   reference/  reference   the double-precision model on CSV, under the firmware's input rules
   simulate/   bench       the simulated test bench: measurement CSVs and CAN logs
@@ -53,6 +54,38 @@ def _cmd_lut(args) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def _cmd_cal_image(args) -> int:
+    from .calibration import cal_image
+    from .generate import cal_image_header
+    if args.show:
+        print(cal_image.describe(cal_image.read_file(args.show)))
+        return 0
+    if not (args.calibration and args.out):
+        raise cal_image.CalImageError("give CAL.toml and --out FILE (or --show FILE)")
+    loop = {"sensor_timeout_periods": args.sensor_timeout, "request_timeout_periods": args.request_timeout,
+            "max_delta_counter": args.max_delta_counter, "sync_counter": args.sync_counter,
+            "recovery_periods": args.recovery_periods}
+    values = cal_image.build(args.calibration, args.shift_toml, args.shift_variant, loop)
+    image = cal_image.write_image_bytes(values)
+    if Path(args.out).suffix == ".h":
+        command = " ".join(["wetclutch cal-image", args.calibration]
+                           + (["--shift-toml", args.shift_toml] if args.shift_toml else [])
+                           + (["--shift-variant", args.shift_variant] if args.shift_variant else [])
+                           + [f"--{k.replace('_', '-')} {v}" for k, v in vars(args).items() if k in _LOOP_OPTIONS
+                              and v is not None] + ["--out", args.out])
+        what = f"'{Path(args.calibration).stem}' ({Path(args.calibration).name}), " + (
+            f"shift calibration {args.shift_variant}" if args.shift_variant else "shift control off")
+        cal_image_header.write_header(args.out, image, command, what)
+    else:
+        cal_image.write_file(args.out, values)
+    print(f"wrote {args.out}: {len(image)} bytes (payload {cal_image.PAYLOAD_BYTES}), film table"
+          f" {values['clutch.film.length']} nodes, shift control {'on' if values['loop.shift_enabled'] else 'off'}")
+    return 0
+
+
+_LOOP_OPTIONS = ("sensor_timeout", "request_timeout", "max_delta_counter", "sync_counter", "recovery_periods")
 
 
 def _cmd_reference(args) -> int:
@@ -289,6 +322,22 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--name", help="C name of the calibration (default: the file's stem)")
     q.add_argument("--max-error", type=float, default=1e-4, help="fail above this relative h_bar error")
     q.set_defaults(func=_cmd_lut)
+
+    q = sub.add_parser("cal-image", help="write the calibration image (wc_cal_image.h) that wc_tcu and wc_replay"
+                       " --calibration-image load; OUT ending in .h: a C header for a compiled-in image")
+    q.add_argument("calibration", nargs="?", help="clutch calibration TOML file")
+    q.add_argument("--out", help="image file to write (atomically); NAME.h: the C header of array NAME")
+    q.add_argument("--shift-variant", metavar="NAME", help="shift control on with this variant (full or"
+                   " shift_1_2_full); default off")
+    q.add_argument("--shift-toml", help="shift calibration TOML (default tools/calibrations/shift_1_2.toml)")
+    for option, limits in (("sensor-timeout", "periods, 1..1000, default 10"),
+                           ("request-timeout", "periods, 1..1000, default 10"),
+                           ("max-delta-counter", "E2E MaxDeltaCounter, 1..7, default 2"),
+                           ("sync-counter", "E2E SyncCounter, 1..15, default 3"),
+                           ("recovery-periods", "1..10000, default 20")):
+        q.add_argument(f"--{option}", type=int, metavar="N", help=f"the loop's {option.replace('-', ' ')} ({limits})")
+    q.add_argument("--show", metavar="FILE", help="read an image: its fields, or why the firmware refuses it")
+    q.set_defaults(func=_cmd_cal_image)
 
     q = sub.add_parser("reference", help="evaluate the double-precision model: CSV in, CSV out")
     q.add_argument("mode", choices=sorted(reference.MODES))
