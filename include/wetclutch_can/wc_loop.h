@@ -156,6 +156,20 @@ typedef struct {
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC);
 
+/* Give a running loop another calibration without resetting its state
+ * (observer, VFS lag, film, lock-up, E2E receivers, a running shift): the
+ * XCP calibration page (wc_xcp.h, DESIGN 13). cal is checked
+ * (wc_calibration_check) and config->shift when not NULL; on any failure
+ * nothing changes and the failing code is returned (WC_CAL_NULL for the
+ * shift calibration, as wc_loop_init). From config the loop takes the
+ * timeouts, E2E, recovery and shift calibration; the bench input and the
+ * adaptation hook stay as wc_loop_init set them. The control period and
+ * the shift control's presence are the port's (its timer, its receive
+ * filter): the caller keeps them (wc_xcp refuses a page that changes
+ * them). Both objects must outlive their use, as at init. Same context as
+ * wc_loop_step, never beside it. */
+wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config);
+
 /* Load the clutch's learned values from an adaptation image (wc_adapt_image.h)
  * after wc_loop_init, before the first step: an image that is NULL, empty,
  * truncated, of another version or clutch, with a bad CRC-32 or a value

@@ -53,6 +53,25 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     return WC_CAL_OK;
 }
 
+wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config)
+{
+    WC_ASSERT((loop != NULL) && (cal != NULL) && (config != NULL));
+    if ((loop == NULL) || (cal == NULL) || (config == NULL)) { return WC_CAL_NULL; }
+    if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
+        return WC_CAL_NULL;
+    }
+    wc_model_t model;
+    const wc_cal_error_t error = wc_model_init(&model, cal);  /* the check and the constants derived once */
+    if (error != WC_CAL_OK) { return error; }
+    loop->clutch.model = model;
+    const wc_loop_config_t kept = loop->config;
+    loop->config = *config;
+    loop->config.bench_input_enabled = kept.bench_input_enabled;
+    loop->config.adaptation_changed = kept.adaptation_changed;
+    loop->config.adaptation_context = kept.adaptation_context;
+    return WC_CAL_OK;
+}
+
 uint32_t wc_loop_load_adaptation(wc_loop_t *loop, const uint8_t *image, size_t length)
 {
     WC_ASSERT(loop != NULL);

@@ -25,10 +25,12 @@
 
 #include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
+#include "wetclutch_can/wc_xcp.h"
 #include "wc_socketcan.h"
 #include "wc_adapt_file.h"
 #include "wc_cal_image_file.h"
 #include "wc_tcu_calibrations.h"
+#include "wc_xcp_signals.h"
 
 /* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
 #define HIST_BIN_NS 1000
@@ -56,6 +58,7 @@ typedef struct {
     unsigned sensor_timeout, request_timeout;
     int bench;                /* --bench: BenchMeasurement used (and passed by the kernel filter) */
     int realtime;             /* --realtime: SCHED_FIFO + mlockall where permitted */
+    int xcp;                  /* --xcp: the XCP on CAN slave (wc_xcp.h) on the same interface */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -118,6 +121,10 @@ static void usage(FILE *out)
             "  -b, --bench               use BenchMeasurement (0x130: load cell, torque sensor) as the\n"
             "                            paper's validation does; off: the frame is filtered out\n"
             "      --realtime            SCHED_FIFO priority 50 and mlockall, where permitted (reported)\n"
+            "      --xcp                 XCP on CAN slave (XcpCommand 0x7F0 / XcpResponse 0x7F1): calibration page\n"
+            "                            and DAQ for a calibration tool (README: Calibration over XCP)\n"
+            "      --xcp-layout          print the XCP regions and the measured signals' addresses as JSON\n"
+            "                            (for `wetclutch a2l`) and exit\n"
             "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
             "  -h, --help\n");
 }
@@ -135,6 +142,30 @@ static int parse_number(const char *text, const char *option, double lo, double 
     return 0;
 }
 
+/* --xcp-layout: the slave's regions (bases of its address space, sizes in
+ * this build) and each measured signal's place, resolved by the compiler
+ * (wc_xcp_signals.c): what `wetclutch a2l` writes the A2L from. */
+static void print_xcp_layout(void)
+{
+    static wc_xcp_t xcp;  /* only its configuration is read */
+    xcp.config = (wc_xcp_config_t)WC_XCP_CONFIG_DEFAULT;
+    wc_xcp_region_t regions[WC_XCP_REGIONS];
+    wc_xcp_regions(&xcp, regions);
+    static const char *const region_names[WC_XCP_REGIONS] = {"cal", "loop", "xcp", "id"};
+    printf("{\n  \"program\": \"wc_tcu\",\n  \"regions\": {");
+    for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
+        printf("%s\"%s\": {\"base\": %u, \"size\": %u}", r ? ", " : "", region_names[r], regions[r].base,
+               regions[r].size);
+    }
+    printf("},\n  \"signals\": [");
+    for (size_t i = 0; i < wc_xcp_signal_count; ++i) {
+        const wc_xcp_signal_t *g = &wc_xcp_signals[i];
+        printf("%s\n    {\"name\": \"%s\", \"region\": \"%s\", \"offset\": %u, \"size\": %u}", i ? "," : "", g->name,
+               (g->region == WC_XCP_SIGNAL_LOOP) ? "loop" : "xcp", g->offset, g->size);
+    }
+    printf("\n  ]\n}\n");
+}
+
 static int parse_options(int argc, char **argv, options_t *o)
 {
     static const struct option longopts[] = {
@@ -145,7 +176,8 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"sensor-timeout", required_argument, NULL, 1}, {"request-timeout", required_argument, NULL, 2},
         {"bench", no_argument, NULL, 'b'},            {"realtime", no_argument, NULL, 3},
         {"shift", required_argument, NULL, 's'},       {"adaptation-file", required_argument, NULL, 4},
-        {"calibration-image", required_argument, NULL, 5},
+        {"calibration-image", required_argument, NULL, 5}, {"xcp", no_argument, NULL, 6},
+        {"xcp-layout", no_argument, NULL, 7},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u};
@@ -170,6 +202,8 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'j': o->stats_json = optarg; break;
         case 'b': o->bench = 1; break;
         case 3: o->realtime = 1; break;
+        case 6: o->xcp = 1; break;
+        case 7: print_xcp_layout(); exit(0);
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 'h':
@@ -253,6 +287,25 @@ static const wc_calibration_t *find_calibration(const char *name)
     return NULL;
 }
 
+/* --xcp: the slave over the loop, its reference page the loop's calibration
+ * encoded as an image payload (the same bytes an image file holds). */
+static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config)
+{
+    static wc_cal_set_t set;
+    static uint8_t reference[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
+    const wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
+    if (!wc_cal_set_from(&set, cal, config->shift, config)) {
+        fprintf(stderr, "wc_tcu: --xcp: the calibration does not fit a calibration page\n");
+        return -1;
+    }
+    wc_cal_image_encode(&set, reference);
+    if (!wc_xcp_init(xcp, loop, reference, &xcp_config)) {
+        fprintf(stderr, "wc_tcu: --xcp: the calibration page does not decode (a bug: the loop accepted it)\n");
+        return -1;
+    }
+    return 0;
+}
+
 /* Everything the main loop counts besides the loop's own counters. */
 typedef struct {
     uint64_t tx_errors;
@@ -289,7 +342,23 @@ static int timer_open(int64_t period_ns)
     return fd;
 }
 
-static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step_times_t *times, port_stats_t *ps)
+/* Sends frames in order; a failure is counted and reported to the loop. */
+static void send_frames(wc_loop_t *loop, wc_socketcan_t *port, port_stats_t *ps, const wc_can_frame_t *frames,
+                        uint32_t n)
+{
+    for (uint32_t i = 0; i < n; ++i) {
+        if (wc_socketcan_send(port, &frames[i]) != 0) {
+            if (ps->tx_errors == 0) {
+                fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port->error);
+            }
+            ps->tx_errors++;
+            wc_loop_port_event(loop, WC_LOOP_PORT_TX_FAILED, 1u);
+        }
+    }
+}
+
+static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_socketcan_t *port, step_times_t *times,
+               port_stats_t *ps)
 {
     int64_t last_rx = -1;  /* the idle timer starts with the first frame */
     const wc_loop_clock_t clock = opt->frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
@@ -344,20 +413,19 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_socketcan_t *port, step
             }
             got = WC_SOCKETCAN_NONE;
         }
+        /* an XCP command goes to the slave, every other frame to the loop */
+        const bool xcp_frame = (xcp != NULL) && (got == WC_SOCKETCAN_FRAME) && (frame.id == WC_CAN_XCP_COMMAND_FRAME_ID);
+        if (xcp_frame) { (void)wc_xcp_receive(xcp, &frame); }  /* a full ring is counted */
         const int64_t t0 = now_ns();
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
-        const uint32_t n = wc_loop_iterate(loop, clock, (got == WC_SOCKETCAN_FRAME) ? &frame : NULL, tick, out);
-        if (n == 0u) { continue; }
-        for (uint32_t i = 0; i < n; ++i) {
-            if (wc_socketcan_send(port, &out[i]) != 0) {
-                if (ps->tx_errors == 0) {
-                    fprintf(stderr, "wc_tcu: %s (counted; further send errors not printed)\n", port->error);
-                }
-                ps->tx_errors++;
-                wc_loop_port_event(loop, WC_LOOP_PORT_TX_FAILED, 1u);
-            }
+        const uint32_t n = wc_loop_iterate(loop, clock, ((got == WC_SOCKETCAN_FRAME) && !xcp_frame) ? &frame : NULL,
+                                           tick, out);
+        send_frames(loop, port, ps, out, n);  /* VfsCommand first, before any XCP frame */
+        if (n > 0u) { record(times, now_ns() - t0); }
+        if (xcp != NULL) {  /* after the step's frames: commands, a changed page, the step's DAQ sample */
+            wc_can_frame_t xout[WC_XCP_TX_FRAMES];
+            send_frames(loop, port, ps, xout, wc_xcp_step(xcp, n > 0u, xout));
         }
-        record(times, now_ns() - t0);
     }
     if (timer_fd >= 0) { (void)close(timer_fd); }
     return 0;
@@ -443,9 +511,14 @@ int main(int argc, char **argv)
         return 1;
     }
 
+    /* The XCP slave: its reference page is the calibration the loop started with, as an image payload. */
+    static wc_xcp_t xcp;
+    if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config) != 0)) { return 2; }
+
     wc_socketcan_t port;
-    uint32_t ids[WC_LOOP_RX_ID_COUNT];
-    const uint32_t id_count = wc_loop_rx_ids(&config, ids);  /* ShiftCommand only with --shift, bench only with --bench */
+    uint32_t ids[WC_LOOP_RX_ID_COUNT + 1u];
+    uint32_t id_count = wc_loop_rx_ids(&config, ids);  /* ShiftCommand only with --shift, bench only with --bench */
+    if (opt.xcp) { ids[id_count++] = WC_CAN_XCP_COMMAND_FRAME_ID; }
     if (wc_socketcan_open(&port, opt.iface, ids, id_count) != 0) {
         fprintf(stderr, "wc_tcu: %s\n", port.error);
         return 1;
@@ -456,7 +529,7 @@ int main(int argc, char **argv)
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
     port_stats_t ps = { 0u, 0u, 0u, 0 };
-    const int status = run(&opt, &loop, &port, &times, &ps);
+    const int status = run(&opt, &loop, (opt.xcp != 0) ? &xcp : NULL, &port, &times, &ps);
     wc_socketcan_close(&port);
     report(stderr, 0, &loop.counters, ps.tx_errors, port.rx_dropped, &times);
     if ((opt.stats_json != NULL) && (write_stats_json(opt.stats_json, &loop.counters, &ps, port.rx_dropped, &times) != 0)) {
