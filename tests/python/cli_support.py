@@ -1,11 +1,14 @@
 """What the command-line fault tests share (test_cli_bad_input.py, test_cli_output_faults.py,
-test_reference_rules.py): cli.main in-process, the one-line error they all expect, a directory's snapshot."""
+test_reference_rules.py, test_mdf.py): cli.main in-process, the one-line error they all expect, a directory's
+snapshot, a made-up replay capture."""
 from __future__ import annotations
 
 import hashlib
+import json
 from pathlib import Path
 
 from wetclutch import cli
+from wetclutch.util import canlog
 
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,3 +48,25 @@ def assert_one_line_error(code: int, err: str, *names) -> None:
     assert lines and all(line.startswith("wetclutch ") for line in lines), err
     for name in names:
         assert str(name) in lines[-1], (name, err)
+
+
+def fake_capture(run_dir: Path, log: Path) -> None:
+    """What `replay` finds in --out after a run on vcan, made up (plausible outputs, no TCU needed), for
+    the analysis (--analyse-only --no-reference-check) to write its report from."""
+    decoded = canlog.decode(canlog.read_log(log))
+    steps = len(decoded[canlog.SENSORS]["_t"])
+    torque = decoded[canlog.BENCH]["MeasuredTorque"]
+    spec = canlog.database().get_message_by_name(canlog.COMMAND)
+    status = {s.name: 0 for s in spec.signals if s.name.startswith("Status")}
+    enc = canlog.Encoder()
+    frames = []
+    for k in range(steps):
+        frames.append((k * 1e-3, enc.frame(canlog.COMMAND, VfsCurrent=100.0, PressureCommand=200.0, **status)))
+        frames.append((k * 1e-3 + 1e-6, enc.frame(canlog.ESTIMATE, EstimatedClutchTemp=40.0, MuF=0.13,
+                                                  ModelTorque=float(torque[min(k, torque.size - 1)]),
+                                                  FilmThickness=5.0, LockState=0)))
+    run_dir.mkdir(parents=True)
+    canlog.write_log(run_dir / "frame1.log", frames)
+    (run_dir / "frame1.json").write_text(json.dumps({
+        "frames_in": 3 * steps, "frames_used": 3 * steps, "frames_out": 2 * steps, "rejected": 0,
+        "rx_dropped_by_kernel": 0, "tx_errors": 0, "steps": steps}))

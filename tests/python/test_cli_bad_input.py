@@ -85,6 +85,7 @@ COMMANDS = {
                                                                  "-c", bad, "--out", out]),
     "convert-asc": (".asc", "asc", lambda bad, out, g: ["convert", bad, out / "out.log"]),
     "convert-blf": (".blf", None, lambda bad, out, g: ["convert", bad, out / "out.log"]),
+    "convert-mdf4": (".log", "log", lambda bad, out, g: ["convert", "--to", "mdf4", bad, out / "out.mf4"]),
     "identify-calibration": (".toml", "toml", lambda bad, out, g: ["identify", "mu", g["campaign"], "-c", bad,
                                                                    "--out", out, "--jobs", "1", "--no-plots"]),
     "identify-true": (".toml", "toml", lambda bad, out, g: ["identify", "mu", g["campaign"], "--true", bad,
@@ -183,10 +184,11 @@ def test_all_nan_force_column_names_file_and_column(tmp_path, capsys):
     assert_one_line_error(code, err, data / "table2" / "run1.csv", "force_N")
 
 
-@pytest.mark.parametrize("command", ["lut", "vectors", "bench", "reference", "replay", "convert", "identify"])
+@pytest.mark.parametrize("command", ["lut", "vectors", "bench", "reference", "replay", "convert", "convert-mdf4",
+                                     "identify"])
 def test_junk_in_a_subprocess_has_no_traceback(command, tmp_path):
     """The real stderr of the real program (no in-process shortcut)."""
-    suffix = {"reference": ".csv", "replay": ".log", "convert": ".asc"}.get(command, ".toml")
+    suffix = {"reference": ".csv", "replay": ".log", "convert": ".asc", "convert-mdf4": ".log"}.get(command, ".toml")
     bad = tmp_path / f"junk{suffix}"
     bad.write_bytes(JUNK)
     out = tmp_path / "out"
@@ -195,6 +197,7 @@ def test_junk_in_a_subprocess_has_no_traceback(command, tmp_path):
             "reference": ["reference", "torque", "-i", bad],
             "replay": ["replay", "--analyse-only", bad, "--out", out],
             "convert": ["convert", bad, out / "x.log"],
+            "convert-mdf4": ["convert", "--to", "mdf4", bad, out / "x.mf4"],
             "identify": ["identify", "mu", tmp_path, "--out", out]}[command]   # the junk CSV is in the data dir
     if command == "identify":
         bad.rename(tmp_path / "junk.csv")

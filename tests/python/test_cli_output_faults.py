@@ -13,7 +13,6 @@ from __future__ import annotations
 import builtins
 import errno
 import io
-import json
 import os
 import re
 import shutil
@@ -21,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from cli_support import ENGAGEMENT_LOG, TABLE1, assert_one_line_error, run, snapshot, temporaries
+from cli_support import ENGAGEMENT_LOG, TABLE1, assert_one_line_error, fake_capture, run, snapshot, temporaries
 from wetclutch.util import atomic, canlog
 
 
@@ -126,28 +125,6 @@ def asc_log(tmp_path_factory) -> Path:
     return path
 
 
-def fake_capture(run_dir: Path, log: Path) -> None:
-    """What `replay` finds in --out after a run on vcan, made up (plausible outputs, no TCU needed), for
-    the analysis (--analyse-only --no-reference-check) to write its report from."""
-    decoded = canlog.decode(canlog.read_log(log))
-    steps = len(decoded[canlog.SENSORS]["_t"])
-    torque = decoded[canlog.BENCH]["MeasuredTorque"]
-    spec = canlog.database().get_message_by_name(canlog.COMMAND)
-    status = {s.name: 0 for s in spec.signals if s.name.startswith("Status")}
-    enc = canlog.Encoder()
-    frames = []
-    for k in range(steps):
-        frames.append((k * 1e-3, enc.frame(canlog.COMMAND, VfsCurrent=100.0, PressureCommand=200.0, **status)))
-        frames.append((k * 1e-3 + 1e-6, enc.frame(canlog.ESTIMATE, EstimatedClutchTemp=40.0, MuF=0.13,
-                                                  ModelTorque=float(torque[min(k, torque.size - 1)]),
-                                                  FilmThickness=5.0, LockState=0)))
-    run_dir.mkdir(parents=True)
-    canlog.write_log(run_dir / "frame1.log", frames)
-    (run_dir / "frame1.json").write_text(json.dumps({
-        "frames_in": 3 * steps, "frames_used": 3 * steps, "frames_out": 2 * steps, "rejected": 0,
-        "rx_dropped_by_kernel": 0, "tx_errors": 0, "steps": steps}))
-
-
 # command -> argv builder(out, fixtures); out is the directory the command writes in
 WRITERS = {
     "lut": lambda out, f: ["lut", TABLE1, "--out", out],
@@ -155,6 +132,7 @@ WRITERS = {
     "bench": lambda out, f: ["bench", "engagement", "--slip", "250", "--out", out],
     "identify": lambda out, f: ["identify", "mu", f["campaign"], "--out", out, "--jobs", "1"],   # PNGs too
     "convert": lambda out, f: ["convert", f["asc"], out / "bench.log"],
+    "convert-mdf4": lambda out, f: ["convert", "--to", "mdf4", ENGAGEMENT_LOG, out / "bench.mf4"],
     "reference": lambda out, f: ["reference", "inverse", "-i", f["csv"], "-o", out / "inverse.csv"],
     "replay": lambda out, f: ["replay", "--analyse-only", "--no-reference-check", ENGAGEMENT_LOG, "--out", out],
 }

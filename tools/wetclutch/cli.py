@@ -8,7 +8,7 @@ commands by role (the folder of tools/wetclutch that does the work):
   simulate/   bench       the simulated test bench: measurement CSVs and CAN logs
   identify/   identify    bench data -> calibration file
   hil/        replay      bench logs to wc_tcu on vcan0, checked against the reference; the report
-              convert     a Vector ASC/BLF log -> candump -L
+              convert     a Vector ASC/BLF log -> candump -L; --to mdf4: a CAN log -> MDF4
   shift/      shift       closed-loop 1->2 upshifts on the plant (simulate/plant)
   studies/    film-study  the squeeze-film state over a family of bench plants
 calibration/ (loading and checking calibration files) and util/ serve them all.
@@ -165,7 +165,8 @@ def _cmd_replay(args) -> int:
         results = [report.analyse(cal, log, run_dir, reference_check=check) for log, run_dir in jobs]
     for (log, run_dir), m in zip(jobs, results):
         print((run_dir / "summary.md").read_text())
-        print(f"report: {run_dir}/summary.md, metrics.json, {', '.join(Path(p).name for p in m['plots'])}")
+        print(f"report: {run_dir}/summary.md, metrics.json, {Path(m['mdf']['path']).name},"
+              f" {', '.join(Path(p).name for p in m['plots'])}")
         if not m["all_targets_met"]:
             missed.append(f"{log.name}: " + ", ".join(k for k, v in m["targets"].items() if not v))
     if missed:
@@ -261,7 +262,8 @@ def _cmd_shift(args) -> int:
     out = Path(args.out or "out/shift")
     metrics = shift.report(out, plant_path=args.plant)
     print((out / "shift_report.md").read_text())
-    print(f"wrote {out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"]))
+    print(f"wrote {out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"])
+          + f" and {len(metrics['mdf'])} MDF4 files (shift_<scenario>_<controller>.mf4)")
     if metrics["missed"]:
         print("wetclutch shift: targets missed: " + ", ".join(metrics["missed"]), file=sys.stderr)
         return 1
@@ -297,6 +299,8 @@ def _adaptation_study(args) -> int:
 
 def _cmd_convert(args) -> int:
     from .hil import convert
+    if args.to == "mdf4":
+        return _convert_mdf4(args)
     stats = convert.convert_log(args.input, args.output, channel=args.channel)
     for where, stamp, previous in stats["out_of_order"][:5]:
         print(f"wetclutch convert: warning: {args.input}: {where}: timestamp {stamp:.6f} s is earlier than the"
@@ -308,6 +312,18 @@ def _cmd_convert(args) -> int:
     print(f"wrote {args.output}: {stats['frames']} frames over {stats['span_s']:.3f} s"
           + (f" (skipped: {skipped})" if skipped else "")
           + (f"; {len(stats['out_of_order'])} out of order" if stats["out_of_order"] else ""))
+    return 0
+
+
+def _convert_mdf4(args) -> int:
+    """wetclutch convert --to mdf4: one line on the frames left out (stderr), one on what was written."""
+    from .hil import convert
+    from .util import mdf
+    res = convert.to_mdf4(args.input, args.output)
+    if mdf.skipped_text(res):
+        print(f"wetclutch convert: warning: {args.input}: {mdf.skipped_text(res)}", file=sys.stderr)
+    print(f"wrote {args.output}: {sum(res['groups'].values())} of {res['frames']} frames over {res['span_s']:.3f} s"
+          f" in {len(res['groups'])} channel groups ({', '.join(res['groups'])})")
     return 0
 
 
@@ -423,9 +439,11 @@ def build_parser() -> argparse.ArgumentParser:
                         " slow and large for table2/thermal")
     q.set_defaults(func=_cmd_bench)
 
-    q = sub.add_parser("convert", help="convert a Vector ASC/BLF log to candump -L (for canplayer)")
-    q.add_argument("input", help="Vector .asc or .blf log")
-    q.add_argument("output", help="candump -L log to write")
+    q = sub.add_parser("convert", help="convert a Vector ASC/BLF log to candump -L (for canplayer), or a candump -L"
+                                       " (or ASC/BLF) log to MDF4 (--to mdf4: signals decoded by hil/wetclutch.dbc)")
+    q.add_argument("input", help="Vector .asc or .blf log (--to mdf4: also a candump -L log)")
+    q.add_argument("output", help="candump -L log to write (--to mdf4: the .mf4 file)")
+    q.add_argument("--to", choices=("candump", "mdf4"), default="candump", help="output format (default candump)")
     q.add_argument("--channel", default="vcan0", help="interface name written in the log (default vcan0)")
     q.set_defaults(func=_cmd_convert)
     return p

@@ -1,11 +1,13 @@
-"""A real bench's Vector ASC or BLF log to candump -L (``wetclutch convert``), for the replay (canplayer)."""
+"""``wetclutch convert``: a real bench's Vector ASC or BLF log to candump -L, for the replay (canplayer);
+a candump -L (or Vector) log to MDF4 (util/mdf.py), for the calibration engineers' tools."""
 from __future__ import annotations
 
 import math
 import re
 from pathlib import Path
 
-from ..util import atomic, canlog
+from ..util import atomic, canlog, mdf
+from ..util.errors import LogError
 
 
 # --------------------------------------------------------------------------- log conversion
@@ -57,6 +59,9 @@ class _CountingLines:
         self.f.close()
 
 
+VECTOR_SUFFIXES = (".asc", ".blf")
+
+
 def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
     """Vector ASC or BLF (python-can readers) -> candump -L (canlog.write_log), written atomically.
 
@@ -69,15 +74,24 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
     timestamp, previous timestamp), where being 'line N' (ASC) or 'frame N' (BLF), for the caller
     to warn about.
     """
+    messages, stats = read_vector_log(in_path)
+    out_path = Path(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic.atomic_path(out_path) as tmp:
+        canlog.write_log(tmp, messages, channel=channel)
+    return stats
+
+
+def read_vector_log(in_path) -> tuple[list, dict]:
+    """The classic CAN data frames of a Vector ASC or BLF log as (timestamp, message) pairs, and
+    convert_log's figures ("frames", "skipped", "span_s", "out_of_order"); its errors (LogError)."""
     import can
     import struct
     import zlib as _zlib
 
-    from ..util.errors import LogError
-
-    in_path, out_path = Path(in_path), Path(out_path)
+    in_path = Path(in_path)
     suffix = in_path.suffix.lower()
-    if suffix not in (".asc", ".blf"):
+    if suffix not in VECTOR_SUFFIXES:
         raise LogError(f"{in_path}: unsupported log format {in_path.suffix or '(no suffix)'!r}:"
                        " expected a Vector .asc or .blf file")
     if not in_path.is_file():
@@ -131,8 +145,25 @@ def convert_log(in_path, out_path, channel: str = "vcan0") -> dict:
         raise LogError(f"{in_path}: line {bad[0]}: {bad[1]}")
     if lines is not None:
         skipped["event"] = lines.events
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.atomic_path(out_path) as tmp:
-        canlog.write_log(tmp, messages, channel=channel)
-    return {"frames": len(messages), "skipped": skipped, "span_s": messages[-1][0] - messages[0][0],
-            "out_of_order": out_of_order}
+    return messages, {"frames": len(messages), "skipped": skipped, "span_s": messages[-1][0] - messages[0][0],
+                      "out_of_order": out_of_order}
+
+
+def to_mdf4(in_path, out_path) -> dict:
+    """A candump -L log (or a Vector .asc/.blf log, read as convert_log reads it) -> MDF4 (util/mdf.py:
+    one channel group per DBC frame, physical values and units from hil/wetclutch.dbc), written
+    atomically. Frames not in the DBC are left out and counted (mdf.write's summary, "unknown" and
+    "malformed" per id); a malformed line, an empty log or a log without any DBC frame raises LogError
+    naming the file (and the line); nothing is written then. Returns the summary with "frames" (the
+    log's) and, for a Vector log, convert_log's "skipped" and "out_of_order"."""
+    in_path = Path(in_path)
+    stats: dict = {"skipped": {}, "out_of_order": []}
+    if in_path.suffix.lower() in VECTOR_SUFFIXES:
+        pairs, stats = read_vector_log(in_path)
+        messages = [msg for _, msg in pairs]
+    else:
+        messages = canlog.read_log(in_path)
+        if not messages:
+            raise LogError(f"{in_path}: empty log (no candump -L line)")
+    summary = mdf.write(out_path, messages, str(in_path))
+    return {**summary, "frames": len(messages), "skipped": stats["skipped"], "out_of_order": stats["out_of_order"]}

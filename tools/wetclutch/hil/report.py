@@ -14,7 +14,7 @@ import numpy as np
 
 from . import replay
 from ..reference import model
-from ..util import atomic, canlog, plotting
+from ..util import atomic, canlog, mdf, plotting
 from ..calibration import Calibration
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15
@@ -27,6 +27,7 @@ FILM_TRANSIENT_S = 0.3       # the paper's transient: contact at 0.9 s, steady f
 SLIPPING_RPM = 10.0          # below this the clutch is (nearly) locked: the model has no static friction
 TEMP_TARGET_K = 2.0
 CAPACITY_QUANTUM_NM = 0.1    # ModelTorque's raw step (0.1 Nm) and theta's (0.1 K) on CAN: the bound's tolerance
+MDF_NAME = "capture.mf4"     # the bus of frame-clock run 1 (replayed frames and the TCU's) as MDF4 (util/mdf.py)
 
 
 @dataclass
@@ -307,7 +308,10 @@ def summary(m: dict, name: str) -> str:
         lines.append(f"TCU frames against the double-precision reference of the same loop: max |Δcurrent| "
                      f"{r['current_mA']:.3f} mA, |Δtorque| {r['torque_Nm']:.3f} Nm, |Δθ| {r['theta_degC']:.3f} K, "
                      f"status mismatches {r['status_mismatches']}.")
-    lines += ["", "Plots: torque.png (Fig. 15), temperature.png (Fig. 14), command.png, status.png.", ""]
+    lines += ["", "Plots: torque.png (Fig. 15), temperature.png (Fig. 14), command.png, status.png.",
+              f"Signals: {MDF_NAME} (MDF4: the bus of frame-clock run 1, the replayed frames and the TCU's, one channel"
+              " group per frame, physical values and units from hil/wetclutch.dbc)"
+              + (f"; {m['mdf']['left_out']}" if m.get("mdf", {}).get("left_out") else "") + ".", ""]
     return "\n".join(lines)
 
 
@@ -329,8 +333,11 @@ def analyse(cal: Calibration, log: Path, run_dir: Path, reference_check: bool = 
     m["log"] = str(log)
     log_check = replay.check_log(log)
     m["log_problems"] = log_check.problems()
-    with atomic.Staged() as out:   # the plots, metrics.json and summary.md: all or none
+    with atomic.Staged() as out:   # the plots, the MDF4 capture, metrics.json and summary.md: all or none
         m["plots"] = plots(cal, s, m, run_dir)
+        written = mdf.write(run_dir / MDF_NAME, capture1, f"{Path(log).name} replayed to wc_tcu, frame clock run 1"
+                                                          f" ({run_dir / 'frame1.log'})")
+        m["mdf"] = {"path": written["path"], "groups": written["groups"], "left_out": mdf.skipped_text(written)}
         out.write_text(run_dir / "metrics.json", json.dumps(m, indent=2, default=float) + "\n")
         out.write_text(run_dir / "summary.md", summary(m, Path(log).name))
     return m

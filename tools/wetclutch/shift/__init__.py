@@ -49,9 +49,10 @@ One module per concern, every name importable from here (``shift.run_case``, ``s
 
 scenarios   paths, thresholds, ShiftError, the scenario matrix
 tcu         InprocTcu (wc_replay --lockstep), VcanTcu (wc_tcu on SocketCAN)
-runner      one shift and a scenario's shifts (run_case), reference_run, run_on_vcan (guest: __main__.py)
+runner      one shift and a scenario's shifts (run_case), their frames (record_messages), reference_run,
+            run_on_vcan (guest: __main__.py)
 quality     the quality vector of a shift, a scenario's worst
-comparison  the matrix x controllers, the feedback gains' search, the targets, the report
+comparison  the matrix x controllers, the feedback gains' search, the targets, the report (and its MDF4 files)
 plots       the Fig. 4-style panels of a scenario
 """
 from __future__ import annotations
@@ -60,7 +61,7 @@ from .comparison import (FEEDBACK_KI, FEEDBACK_KP, INERTIA_TOLERANCE, JERK_LIMIT
                          markdown, report, run_matrix, targets, tune_feedback)
 from .plots import plot_case
 from .quality import quality, worst
-from .runner import frame_sequence, reference_run, run_case, run_on_vcan
+from .runner import frame_sequence, record_messages, reference_run, run_case, run_on_vcan
 from .scenarios import (ABORT_NAMES, CONTROLLERS, FLARE_RPM, JERK_CUTOFF_HZ, NOMINAL, ROOT, SHIFT_TOML, SOAK_SHIFTS,
                         SYNC_BAND_RAD_S, TARGET_INERTIA_S, TCU_CALIBRATION, TIE_UP_FRACTION, WC_REPLAY, Scenario,
                         ShiftError, scenario_matrix)
@@ -70,6 +71,6 @@ __all__ = [
     "ABORT_NAMES", "CONTROLLERS", "FEEDBACK_KI", "FEEDBACK_KP", "FLARE_RPM", "INERTIA_TOLERANCE", "JERK_CUTOFF_HZ",
     "JERK_LIMIT_M_S3", "NOMINAL", "PRESSURE_RATIO_TARGET", "ROOT", "SHIFT_TOML", "SOAK_SHIFTS", "SYNC_BAND_RAD_S",
     "TARGET_INERTIA_S", "TCU_CALIBRATION", "TIE_UP_FRACTION", "WC_REPLAY", "InprocTcu", "Scenario", "ShiftError",
-    "VcanTcu", "frame_sequence", "markdown", "plot_case", "quality", "reference_run", "report", "run_case",
-    "run_matrix", "run_on_vcan", "scenario_matrix", "targets", "tune_feedback", "worst",
+    "VcanTcu", "frame_sequence", "markdown", "plot_case", "quality", "record_messages", "reference_run", "report",
+    "run_case", "run_matrix", "run_on_vcan", "scenario_matrix", "targets", "tune_feedback", "worst",
 ]

@@ -1,5 +1,5 @@
 """The comparison (issue 13): the scenario matrix x controllers, the feedback gains' search, the targets,
-shift_report.md, metrics.json and the plots (``wetclutch shift``)."""
+shift_report.md, metrics.json, the plots and the kept runs' frames as MDF4 (``wetclutch shift``)."""
 from __future__ import annotations
 
 import json
@@ -10,10 +10,11 @@ import numpy as np
 
 from ..calibration import shift as shift_calibration
 from ..simulate import plant as plant_mod
+from ..util import mdf
 from ..util.atomic import Staged
 from .plots import plot_case
 from .quality import quality, worst
-from .runner import run_case
+from .runner import record_messages, run_case
 from .scenarios import NOMINAL, SHIFT_TOML, TARGET_INERTIA_S, scenario_matrix
 
 
@@ -161,7 +162,31 @@ def report(out_dir: Path, plant_path=plant_mod.DEFAULT_PLANT, scenarios=None) ->
     metrics = {"plant": str(plant_path), "target_inertia_s": TARGET_INERTIA_S, "cases": res["cases"],
                "nolag_nominal": nolag, "targets": tg, "plots": plots,
                "missed": [k for k, t in tg.items() if not t["met"]]}
-    with Staged() as staged:
+    with Staged() as staged:   # the MDF4 files, metrics.json and shift_report.md: all or none
+        metrics["mdf"] = write_mdf(out_dir, res["records"], Path(plant_path).name)
         staged.write_text(out_dir / "metrics.json", json.dumps(metrics, indent=1, default=float, sort_keys=True))
-        staged.write_text(out_dir / "shift_report.md", markdown(res["cases"], tg))
+        staged.write_text(out_dir / "shift_report.md", markdown(res["cases"], tg) + _mdf_paragraph(metrics["mdf"]))
     return metrics
+
+
+def mdf_name(scenario: str, controller: str) -> str:
+    return f"shift_{scenario}_{controller}.mf4"
+
+
+def write_mdf(out_dir: Path, records: dict, plant_name: str) -> list[str]:
+    """One MDF4 file per kept run (controller x scenario, runner.record_messages: the frames both ways of
+    every shift of the run, decoded by the DBC, util/mdf.py) in out_dir; returns their paths."""
+    written = []
+    for (ctrl, sc), recs in sorted(records.items(), key=lambda item: (item[0][1], item[0][0])):
+        path = out_dir / mdf_name(sc, ctrl)
+        mdf.write(path, record_messages(recs), f"1->2 upshift, scenario {sc}, controller {ctrl}, plant {plant_name}"
+                  f" ({len(recs)} shift(s), the time between them left out)")
+        written.append(str(path))
+    return written
+
+
+def _mdf_paragraph(paths: list[str]) -> str:
+    return ("\n## Signals (MDF4)\n\nThe frames both ways of each kept run (what the TCU received and sent, every"
+            " shift of the run; the idle time between the soak's shifts is not kept), one file per controller and"
+            " scenario, one channel group per frame, physical values and units from hil/wetclutch.dbc: "
+            + ", ".join(Path(p).name for p in paths) + ".\n")

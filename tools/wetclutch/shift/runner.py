@@ -119,6 +119,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["frames"] = frames_out
     rec["frames_in"] = frames_in
     rec["report"] = report
+    rec["t0_s"] = t0_s           # the TCU's time of step k: t0_s + t_s[k]
     rec["command_step"] = n_pre
     rec["inertia_step"] = k_i
     start = rec["sensor_slip_rad_s"][k_i]
@@ -127,6 +128,22 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["reference_slip_rad_s"] = ref
     rec["end_theta_degC"] = float(truth["theta_clutch_degC"][-1])
     return rec
+
+
+def record_messages(records: list[dict]) -> list:
+    """The frames of a case's shifts both ways, per step what the TCU received then what it sent, as
+    python-can Messages stamped with the TCU's time (t0_s + t_s[k]), for util/mdf. The frames between two
+    shifts (between_shifts: idle, no slip) are not kept by the records, so not here either."""
+    out = []
+    for rec in records:
+        sent: dict[int, list] = {}
+        for k, fid, data in rec["frames"]:
+            sent.setdefault(k, []).append((fid, bytes.fromhex(data)))
+        for k, received in enumerate(rec["frames_in"]):
+            t = rec["t0_s"] + rec["t_s"][k]
+            out += [canlog.can.Message(timestamp=t, arbitration_id=fid, is_extended_id=False, data=data)
+                    for fid, data in received + sent.get(k, [])]
+    return out
 
 
 BETWEEN_SHIFTS_S = 0.5   # back-to-back shifts: the 2->1 downshift's release between them (see between_shifts)

@@ -126,23 +126,28 @@ def read_log(path: Path) -> list[can.Message]:
     return messages
 
 
-def decode(messages, db=None) -> dict[str, dict[str, np.ndarray]]:
-    """Decode every known frame into arrays of physical values per frame name,
-    plus '_t' (timestamps). Unknown ids are counted under '_unknown', frames
-    of a known id with the wrong length under '_malformed': counted, not used."""
+def decode(messages, db=None, scaling: bool = True) -> dict[str, dict[str, np.ndarray]]:
+    """Decode every known frame into arrays of physical values per frame name (raw values with
+    scaling=False, exact as floats: no signal is wider than 53 bits), plus '_t' (timestamps). Frames of
+    an id not in the DBC (or of an extended id: the DBC's are standard) are counted under '_unknown',
+    frames of a known id with the wrong length (a remote frame, a short one) under '_malformed': counted,
+    not used; each also counts them per id under 'ids' ({id: count})."""
     db = db or database()
     rows: dict[str, list] = {}
-    unknown = malformed = 0
+    unknown: dict[int, int] = {}
+    malformed: dict[int, int] = {}
     for msg in messages:
         try:
             spec = db.get_message_by_frame_id(msg.arbitration_id)
         except KeyError:
-            unknown += 1
+            spec = None
+        if spec is None or bool(msg.is_extended_id) != spec.is_extended_frame:
+            unknown[msg.arbitration_id] = unknown.get(msg.arbitration_id, 0) + 1
             continue
         if len(msg.data) != spec.length:
-            malformed += 1
+            malformed[msg.arbitration_id] = malformed.get(msg.arbitration_id, 0) + 1
             continue
-        values = spec.decode(bytes(msg.data), decode_choices=False, scaling=True)
+        values = spec.decode(bytes(msg.data), decode_choices=False, scaling=scaling)
         rows.setdefault(spec.name, []).append((msg.timestamp, values))
     out = {}
     for name, items in rows.items():
@@ -150,6 +155,6 @@ def decode(messages, db=None) -> dict[str, dict[str, np.ndarray]]:
         for key in items[0][1]:
             cols[key] = np.array([float(v[key]) for _, v in items])
         out[name] = cols
-    out["_unknown"] = {"count": unknown}
-    out["_malformed"] = {"count": malformed}
+    out["_unknown"] = {"count": sum(unknown.values()), "ids": unknown}
+    out["_malformed"] = {"count": sum(malformed.values()), "ids": malformed}
     return out
