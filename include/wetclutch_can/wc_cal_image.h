@@ -102,7 +102,7 @@ typedef enum {
  * layout's order. */
 typedef enum {
     WC_CAL_LOOP_OK = 0,
-    WC_CAL_LOOP_SHIFT_ENABLED,       /* neither 0 nor 1 */
+    WC_CAL_LOOP_SHIFT_ENABLED,       /* shift_enabled neither 0 nor 1 */
     WC_CAL_LOOP_SENSOR_TIMEOUT,      /* sensor_timeout_periods outside 1..1000 */
     WC_CAL_LOOP_REQUEST_TIMEOUT,     /* request_timeout_periods outside 1..1000 */
     WC_CAL_LOOP_MAX_DELTA_COUNTER,   /* e2e.max_delta_counter outside 1..7 */
