@@ -42,6 +42,13 @@
  *                               TorqueRequest, ShiftCommand) queued per period.
  * The shift must complete (LOCKED, one report, no safe step) or RESULT FAIL.
  *
+ * The calibration image (DESIGN 13): one wc_cal_image_load of the committed
+ * lut/wc_table1_cal_image.h (linked into its own .wc_calibration section,
+ * mps2_an386.ld), which must be accepted (image, film layout,
+ * wc_calibration_check, wc_shift_calibration_check, loop limits) and give
+ * table1 (row wc_cal_image_load:table1_full; one sample: the same bytes
+ * every time).
+ *
  * Output lines (parsed by scripts/bench_arm.sh):
  *   EMPTY <instructions>        window overhead, subtracted from every figure
  *   NOP <instructions>          1000 nops (must read 1000)
@@ -54,14 +61,17 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include <wetclutch/wetclutch.h>
+#include <wetclutch_can/wc_cal_image.h>
 #include <wetclutch_can/wc_can_signals.h>
 #include <wetclutch_can/wc_loop.h>
 
 #include "wc_arm_calibration.h"
 #include "wc_arm_io.h"
 #include "wc_arm_naive.h"
+#include "wc_table1_cal_image.h"  /* lut/: table1 + shift_1_2_full, in the .wc_calibration section */
 #include "wc_test_fixtures.h"  /* tests/c: the shift scenario of the C tests */
 
 #ifndef WC_ARM_BENCH_LEVEL
@@ -127,6 +137,7 @@ typedef enum {
     ROW_LOOP_STEP_SHIFT_FILM,
     ROW_SHIFT_STEP_ADAPT,
     ROW_SHIFT_END_ADAPT,
+    ROW_CAL_IMAGE_LOAD,
     ROWS
 } row_t;
 
@@ -135,6 +146,7 @@ static const char *const row_name[ROWS] = {
     [ROW_CLUTCH_STEP] = "wc_clutch_step",
     [ROW_SHIFT_STEP_ADAPT] = "wc_shift_step:inertia_adaptive",
     [ROW_SHIFT_END_ADAPT] = "wc_shift_step:end_adaptive",
+    [ROW_CAL_IMAGE_LOAD] = "wc_cal_image_load:table1_full",
     [ROW_CLUTCH_STEP_FILM] = "wc_clutch_step:film",
     [ROW_CLUTCH_STEP_FILM_LAG] = "wc_clutch_step:film_lag",
     [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
@@ -207,6 +219,8 @@ typedef struct {
     wc_adapt_t *adapt;                       /* the shift rows: NULL (adaptation off) or the adaptive run's */
     wc_shift_command_t shift_command;
     wc_shift_report_t shift_report;
+    wc_cal_set_t *cal_set;
+    wc_cal_image_status_t cal_image_status;
     bool shift_ended;
 } bench_ctx_t;
 
@@ -289,6 +303,11 @@ THUNK(thunk_encode_clutch_estimate)
 {
     bench_ctx_t *c = ctx;
     c->can_result = wc_can_encode_clutch_estimate(c->out_frame, &c->estimate, sizeof c->out_frame);
+}
+THUNK(thunk_cal_image_load)
+{
+    bench_ctx_t *c = ctx;
+    c->cal_image_status = wc_cal_image_load(wc_table1_cal_image, sizeof wc_table1_cal_image, c->cal_set);
 }
 THUNK(thunk_crc8)
 {
@@ -764,6 +783,14 @@ int main(void)
                     bench_point(slip_grid_rpm[s], theta_grid_degC[t], request_grid[r], &worst);
                 }
             }
+        }
+
+        static wc_cal_set_t cal_set;
+        ctx.cal_set = &cal_set;
+        record(ROW_CAL_IMAGE_LOAD, measure(thunk_cal_image_load, &ctx));
+        if ((ctx.cal_image_status.result != (uint32_t)WC_CAL_IMAGE_OK) ||
+            (memcmp(&cal_set.clutch, wc_arm_calibration, offsetof(wc_calibration_t, film)) != 0) || !cal_set.shift_enabled) {
+            fail("wc_cal_image_load: the committed table1 image refused or not table1");
         }
 
         bench_shift_step(wc_arm_calibration, ROW_SHIFT_STEP, false, ROW_SHIFT_STEP);

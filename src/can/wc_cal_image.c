@@ -135,6 +135,18 @@ size_t wc_cal_image_write(const wc_cal_set_t *set, uint8_t *image, size_t capaci
     return wc_image_seal(image, capacity, WC_CAL_IMAGE_MAGIC, WC_CAL_IMAGE_VERSION, WC_CAL_IMAGE_PAYLOAD_BYTES);
 }
 
+/* A calibration struct copied byte by byte: no C library call (the ARM
+ * footprint check links only what its firmware uses; a struct assignment of
+ * this size is a memcpy call). */
+static void copy_bytes(void *destination, const void *source, size_t bytes)
+{
+    unsigned char *d = (unsigned char *)destination;
+    const unsigned char *s = (const unsigned char *)source;
+    for (size_t i = 0u; (i < bytes) && (i < sizeof(wc_shift_calibration_t) + sizeof(wc_calibration_t)); ++i) {
+        d[i] = s[i];
+    }
+}
+
 bool wc_cal_set_from(wc_cal_set_t *set, const wc_calibration_t *clutch, const wc_shift_calibration_t *shift,
                      const wc_loop_config_t *loop)
 {
@@ -145,7 +157,7 @@ bool wc_cal_set_from(wc_cal_set_t *set, const wc_calibration_t *clutch, const wc
         (clutch->film.hbar_m == NULL) || (clutch->film.slope_m_per_Pa == NULL)) {
         return false;
     }
-    set->clutch = *clutch;
+    copy_bytes(&set->clutch, clutch, sizeof set->clutch);
     for (uint32_t i = 0u; (i < clutch->film.length) && (i < WC_CAL_IMAGE_FILM_NODES); ++i) {
         set->film_pressure_Pa[i] = clutch->film.pressure_Pa[i];
         set->film_hbar_m[i] = clutch->film.hbar_m[i];
@@ -155,7 +167,7 @@ bool wc_cal_set_from(wc_cal_set_t *set, const wc_calibration_t *clutch, const wc
     set->clutch.film.hbar_m = set->film_hbar_m;
     set->clutch.film.slope_m_per_Pa = set->film_slope_m_per_Pa;
     if (shift != NULL) {
-        set->shift = *shift;
+        copy_bytes(&set->shift, shift, sizeof set->shift);
         set->shift_enabled = true;
     }
     const wc_loop_config_t defaults = WC_LOOP_CONFIG_DEFAULT;
