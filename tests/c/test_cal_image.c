@@ -35,21 +35,7 @@ static uint32_t word_at(const void *base, size_t offset)
 
 static size_t read_golden(uint8_t *out, size_t capacity)
 {
-    FILE *f = fopen(WC_TEST_VECTORS_DIR "/wc_cal_image_golden.hex", "r");
-    assert_non_null(f);
-    char line[256];
-    size_t n = 0u;
-    while (fgets(line, sizeof line, f) != NULL) {
-        if (line[0] == '#') { continue; }
-        unsigned byte;
-        int used;
-        for (const char *p = line; sscanf(p, " %2x%n", &byte, &used) == 1; p += used) {
-            assert_true(n < capacity);
-            out[n++] = (uint8_t)byte;
-        }
-    }
-    fclose(f);
-    return n;
+    return wc_test_read_hex(WC_TEST_VECTORS_DIR "/wc_cal_image_golden.hex", out, capacity);
 }
 
 static void test_payload_size(void **state)

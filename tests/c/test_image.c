@@ -224,24 +224,10 @@ static wc_adapt_values_t golden_values(void)
     return v;
 }
 
-/* The golden image: its hex digits, '#' lines skipped. */
+/* The golden image (wc_test_read_hex). */
 static size_t read_golden(uint8_t *out, size_t capacity)
 {
-    FILE *f = fopen(WC_TEST_VECTORS_DIR "/wc_adapt_image_golden.hex", "r");
-    assert_non_null(f);
-    char line[256];
-    size_t n = 0u;
-    while (fgets(line, sizeof line, f) != NULL) {
-        if (line[0] == '#') { continue; }
-        unsigned byte;
-        int used;
-        for (const char *p = line; sscanf(p, " %2x%n", &byte, &used) == 1; p += used) {
-            assert_true(n < capacity);
-            out[n++] = (uint8_t)byte;
-        }
-    }
-    fclose(f);
-    return n;
+    return wc_test_read_hex(WC_TEST_VECTORS_DIR "/wc_adapt_image_golden.hex", out, capacity);
 }
 
 static void assert_defaults(const wc_adapt_t *adapt)

@@ -10,6 +10,7 @@
 #include <setjmp.h>
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 #include <math.h>
 #include <cmocka.h>
@@ -93,5 +94,27 @@ static inline void wc_test_worst_print(const char *what, const wc_test_worst_t *
             _fail(__FILE__, __LINE__);            \
         }                                         \
     } while (0)
+
+/* A golden image written by a Python test (tests/vectors/NAME.hex): its
+ * hex digits into out (at most capacity bytes), '#' lines skipped. Returns
+ * the bytes read. */
+static inline size_t wc_test_read_hex(const char *path, uint8_t *out, size_t capacity)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[256];
+    size_t n = 0u;
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (line[0] == '#') { continue; }
+        unsigned byte;
+        int used;
+        for (const char *p = line; sscanf(p, " %2x%n", &byte, &used) == 1; p += used) {
+            assert_true(n < capacity);
+            out[n++] = (uint8_t)byte;
+        }
+    }
+    fclose(f);
+    return n;
+}
 
 #endif /* WC_TEST_SUPPORT_H */

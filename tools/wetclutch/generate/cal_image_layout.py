@@ -63,23 +63,20 @@ def header_text() -> str:
 
 
 def _put(f: layout.Field, index: str) -> str:
-    at = f"&payload[{macro(f)}{' + 4u * i' if index else ''}]"
     value = f"set->{f.member}{index}"
-    if f.c_type == "bool":
-        value = f"{value} ? 1u : 0u"
-    elif f.c_type:
-        value = f"(uint32_t){value}"
-    return f"wc_image_put_{f.ctype}({at}, {value});"
+    value = {"bool": f"{value} ? 1u : 0u", "": value}.get(f.c_type, f"(uint32_t){value}")
+    return f"wc_image_put_{f.ctype}({_at(f, index)}, {value});"
 
 
 def _get(f: layout.Field, index: str) -> str:
-    at = f"&payload[{macro(f)}{' + 4u * i' if index else ''}]"
-    value = f"wc_image_get_{f.ctype}({at})"
-    if f.c_type == "bool":
-        value = f"({value} != 0u)"
-    elif f.c_type:
-        value = f"({f.c_type}){value}"
+    value = f"wc_image_get_{f.ctype}({_at(f, index)})"
+    value = {"bool": f"({value} != 0u)", "": value}.get(f.c_type, f"({f.c_type}){value}")
     return f"set->{f.member}{index} = {value};"
+
+
+def _at(f: layout.Field, index: str) -> str:
+    """The payload address of a field (of its element i in a loop)."""
+    return f"&payload[{macro(f)}{' + 4u * i' if index else ''}]"
 
 
 def _body(statement) -> list[str]:
