@@ -7,6 +7,7 @@ commands by role (the folder of tools/wetclutch that does the work):
   reference/  reference   the double-precision model on CSV, under the firmware's input rules
   simulate/   bench       the simulated test bench: measurement CSVs and CAN logs
   identify/   identify    bench data -> calibration file
+  generate/   a2l         the A2L of the TCU's XCP slave (addresses from wc_tcu --xcp-layout)
   hil/        replay      bench logs to wc_tcu on vcan0, checked against the reference; the report
               convert     a Vector ASC/BLF log -> candump -L; --to mdf4: a CAN log -> MDF4
   shift/      shift       closed-loop 1->2 upshifts on the plant (simulate/plant)
@@ -297,6 +298,13 @@ def _adaptation_study(args) -> int:
     return 0
 
 
+def _cmd_a2l(args) -> int:
+    from .generate import a2l
+    layout = a2l.read_layout(tcu=Path(args.tcu), layout_file=Path(args.layout) if args.layout else None)
+    print(f"wrote {a2l.write_a2l(layout, Path(args.out))}")
+    return 0
+
+
 def _cmd_convert(args) -> int:
     from .hil import convert
     if args.to == "mdf4":
@@ -438,6 +446,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="table2/thermal/breakaway: also write the 1 ms CAN logs (and 1 ms CSVs for table2/thermal);"
                         " slow and large for table2/thermal")
     q.set_defaults(func=_cmd_bench)
+
+    q = sub.add_parser("a2l", help="write the A2L of the TCU's XCP slave (calibration page and measurements,"
+                                   " addresses from the linked program)")
+    q.add_argument("--tcu", default="build/host-release/src/port/wc_tcu",
+                   help="the TCU program whose --xcp-layout gives the addresses (default the host-release build)")
+    q.add_argument("--layout", help="a saved copy of its --xcp-layout output instead")
+    q.add_argument("--out", default="out/xcp/wetclutch.a2l", help="A2L file to write (default out/xcp/wetclutch.a2l)")
+    q.set_defaults(func=_cmd_a2l)
 
     q = sub.add_parser("convert", help="convert a Vector ASC/BLF log to candump -L (for canplayer), or a candump -L"
                                        " (or ASC/BLF) log to MDF4 (--to mdf4: signals decoded by hil/wetclutch.dbc)")
