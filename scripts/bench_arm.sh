@@ -14,7 +14,8 @@
 #    calibration reads 1000, the naive inverse agrees with wc_inverse, every
 #    loop frame was accepted) and their outputs are byte-identical.
 # 3. Prints one table (function | -Os median / worst | -O2 median / worst),
-#    the naive/library ratio of the inverse and the flash of each library per
+#    the naive/library ratio of the inverse and the flash of each library (and of
+#    the XCP slave's object in the CAN layer) per
 #    level, and writes it to build/arm-bench/report.md.
 # 4. FAILS when a worst case exceeds its ceiling in bench/arm_ceilings.txt, or
 #    when a measured function has no ceiling there (for either level).
@@ -94,13 +95,21 @@ for level in "${levels[@]}"; do
   ratio_worst[$level]=$(awk '$1 == "NAIVE" && $2 == "ratio_solve_median" { print $5 }' "$out")
   force_diff[$level]=$(awk '$1 == "NAIVE" && $2 == "force_diff_worst_N" { print $3 }' "$out")
 
-  for lib in model can cal; do
+  for lib in model can xcp cal; do
+    member=
     case $lib in
       model) archive=$build/wetclutch/src/model/libwetclutch.a ;;
       can) archive=$build/wetclutch/src/can/libwetclutch_can.a ;;
+      xcp) archive=$build/wetclutch/src/can/libwetclutch_can.a; member=wc_xcp.c.obj ;;
       cal) archive=$build/libwc_arm_calibration.a ;;
     esac
-    read -r t d b < <(${prefix}size -t "$archive" | awk 'END { print $1, $2, $3 }')
+    t=
+    if [ -n "$member" ]; then  # one object of the archive
+      read -r t d b < <(${prefix}size "$archive" | awk -v m="$member" '$6 == m { print $1, $2, $3 }') || true
+    else
+      read -r t d b < <(${prefix}size -t "$archive" | awk 'END { print $1, $2, $3 }')
+    fi
+    if [ -z "${t:-}" ]; then echo "bench_arm: FAIL: no $lib object in $archive" >&2; exit 1; fi
     flash_text[$level,$lib]=$t
     flash_data[$level,$lib]=$d
     flash_bss[$level,$lib]=$b
@@ -173,10 +182,11 @@ qemu_version=$(qemu-system-arm --version | awk 'NR == 1 { print $4 }')
   echo
   echo "| library | -Os | -O2 |"
   echo "|---|---:|---:|"
-  for lib in model can cal; do
+  for lib in model can xcp cal; do
     case $lib in
       model) label='model, `libwetclutch.a`' ;;
       can) label='CAN layer, `libwetclutch_can.a`' ;;
+      xcp) label='of which the XCP slave, `wc_xcp.c`' ;;
       cal) label='table1 calibration + h̄ LUT (`wc_arm_calibration.c`)' ;;
     esac
     echo "| $label | ${flash_text[Os,$lib]} / ${flash_data[Os,$lib]} / ${flash_bss[Os,$lib]} | ${flash_text[O2,$lib]} / ${flash_data[O2,$lib]} / ${flash_bss[O2,$lib]} |"

@@ -8,8 +8,12 @@
 # 2. Compiles, with the library's own flags, three small ARM translation units:
 #    the table1 calibration (the LUT is static const data in lut/ headers, so it
 #    lands in the user's TU), a probe whose object sizes carry sizeof(wc_clutch_t)
-#    and WC_INVERSE_MAX_ITERATIONS, and a firmware main that inits and steps one
-#    clutch (linked against a baseline main to get the flash a user pays).
+#    and WC_INVERSE_MAX_ITERATIONS (and sizeof(wc_xcp_t) by part), and a firmware
+#    main that inits and steps one clutch and the CAN frame loop (linked against a
+#    baseline main to get the flash a user pays), once more with the XCP slave
+#    stepped after the loop (wc_xcp.h; the difference is the slave's cost, and
+#    the stack analysis reads this image, so that every library function's
+#    C-library callees are in it).
 # 3. FAILS (exit 1) if any of these ARM objects, or the part of the linked image
 #    that the library brings in, references heap, stdio, a double-precision libm
 #    function or a soft-double helper (__aeabi_d*, __aeabi_f2d, ...).
@@ -57,6 +61,7 @@ EOF
 cat >"$work/wc_arm_probe.c" <<'EOF'
 /* Compile-time figures, read back from the object's symbol sizes (nm -S). */
 #include "wetclutch/wetclutch.h"
+#include "wetclutch_can/wc_xcp.h"
 
 extern const unsigned char wc_probe_sizeof_clutch[sizeof(wc_clutch_t)];
 const unsigned char wc_probe_sizeof_clutch[sizeof(wc_clutch_t)] = {0u};
@@ -64,6 +69,18 @@ extern const unsigned char wc_probe_sizeof_model[sizeof(wc_model_t)];
 const unsigned char wc_probe_sizeof_model[sizeof(wc_model_t)] = {0u};
 extern const unsigned char wc_probe_inverse_max_iterations[WC_INVERSE_MAX_ITERATIONS];
 const unsigned char wc_probe_inverse_max_iterations[WC_INVERSE_MAX_ITERATIONS] = {0u};
+/* The XCP slave's state and its parts. */
+#define XCP_FIELD(f) sizeof(((const wc_xcp_t *)0)->f)
+extern const unsigned char wc_probe_sizeof_xcp[sizeof(wc_xcp_t)];
+const unsigned char wc_probe_sizeof_xcp[sizeof(wc_xcp_t)] = {0u};
+extern const unsigned char wc_probe_sizeof_xcp_page[XCP_FIELD(working_page)];
+const unsigned char wc_probe_sizeof_xcp_page[XCP_FIELD(working_page)] = {0u};
+extern const unsigned char wc_probe_sizeof_xcp_sets[XCP_FIELD(sets)];
+const unsigned char wc_probe_sizeof_xcp_sets[XCP_FIELD(sets)] = {0u};
+extern const unsigned char wc_probe_sizeof_xcp_daq[XCP_FIELD(lists) + XCP_FIELD(odts) + XCP_FIELD(entries)];
+const unsigned char wc_probe_sizeof_xcp_daq[XCP_FIELD(lists) + XCP_FIELD(odts) + XCP_FIELD(entries)] = {0u};
+extern const unsigned char wc_probe_sizeof_xcp_rx[XCP_FIELD(rx)];
+const unsigned char wc_probe_sizeof_xcp_rx[XCP_FIELD(rx)] = {0u};
 EOF
 cat >"$work/wc_arm_main.c" <<'EOF'
 /* Smallest firmware that uses the library: init one clutch from table1, step it,
@@ -71,12 +88,19 @@ cat >"$work/wc_arm_main.c" <<'EOF'
 #include "wetclutch/wetclutch.h"
 #include "wetclutch_can/wc_loop.h"
 #include "wc_table1_calibration.h"
+#ifdef WC_PROBE_XCP
+#include "wetclutch_can/wc_xcp.h"
+#include "wc_table1_cal_image.h"
+#endif
 
 volatile float wc_probe_in[4];
 volatile float wc_probe_out;
 volatile uint8_t wc_probe_frame[8];
 static wc_clutch_t clutch;
 static wc_loop_t loop;
+#ifdef WC_PROBE_XCP
+static wc_xcp_t xcp;
+#endif
 
 int main(void)
 {
@@ -97,6 +121,18 @@ int main(void)
     wc_can_frame_t tx[WC_LOOP_TX_FRAMES];
     (void)wc_loop_step(&loop, tx);
     wc_probe_frame[0] = tx[0].data[2];
+#ifdef WC_PROBE_XCP
+    /* The XCP slave after the loop step: the table1 image's payload as its reference page,
+     * one command frame received, one step. */
+    const wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
+    if (!wc_xcp_init(&xcp, &loop, &wc_table1_cal_image[WC_IMAGE_HEADER_BYTES], &xcp_config)) { return 1; }
+    wc_can_frame_t command = { WC_CAN_XCP_COMMAND_FRAME_ID, 8u, 0u, {0u} };
+    for (unsigned i = 0u; i < 8u; ++i) { command.data[i] = wc_probe_frame[i]; }
+    (void)wc_xcp_receive(&xcp, &command);
+    wc_can_frame_t xcp_tx[WC_XCP_TX_FRAMES];
+    const uint32_t xcp_frames = wc_xcp_step(&xcp, true, xcp_tx);
+    wc_probe_frame[1] = (xcp_frames > 0u) ? xcp_tx[0].data[0] : 0u;
+#endif
     return (int)out.status;
 }
 EOF
@@ -137,9 +173,14 @@ for tu in wc_arm_calibration wc_arm_probe wc_arm_main wc_arm_baseline; do
     cat "$log" >&2; echo "check_arm: FAIL: compiling probe $tu.c" >&2; exit 1
   fi
 done
+if ! (cd "$work" && ${prefix}gcc "${cflags[@]}" -DWC_PROBE_XCP -c wc_arm_main.c -o wc_arm_main_xcp.o) >"$log" 2>&1; then
+  cat "$log" >&2; echo "check_arm: FAIL: compiling probe wc_arm_main.c with the XCP slave" >&2; exit 1
+fi
 ldflags=("${cpu_flags[@]}" -Os --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections)
 if ! { ${prefix}gcc "${ldflags[@]}" -o "$work/firmware.elf" "$work/wc_arm_main.o" "$can_lib" "$lib" -lm \
          -Wl,-Map="$work/firmware.map" &&
+       ${prefix}gcc "${ldflags[@]}" -o "$work/firmware_xcp.elf" "$work/wc_arm_main_xcp.o" "$can_lib" "$lib" -lm \
+         -Wl,-Map="$work/firmware_xcp.map" &&
        ${prefix}gcc "${ldflags[@]}" -o "$work/baseline.elf" "$work/wc_arm_baseline.o"; } >"$log" 2>&1; then
   cat "$log" >&2; echo "check_arm: FAIL: linking the probe firmware" >&2; exit 1
 fi
@@ -159,7 +200,8 @@ undefined=$( { ${prefix}nm -u "$lib" "$can_lib"; ${prefix}nm -u "$work"/wc_arm_c
 bad_objects=$(grep -E "$forbidden_re" <<<"$undefined" || true)
 # Functions the library brings into a linked image (not in the baseline image).
 defined() { ${prefix}nm --defined-only "$1" | awk '$2 ~ /^[TtWw]$/ { print $3 }' | sort -u; }
-brought_in=$(comm -23 <(defined "$work/firmware.elf") <(defined "$work/baseline.elf"))
+brought_in=$(comm -23 <( { defined "$work/firmware.elf"; defined "$work/firmware_xcp.elf"; } | sort -u) \
+                      <(defined "$work/baseline.elf"))
 bad_image=$(grep -E "$forbidden_re" <<<"$brought_in" || true)
 if [ -n "$bad_objects" ]; then
   echo "check_arm: FAIL: ARM objects reference forbidden symbols:" >&2
@@ -184,6 +226,15 @@ read -r can_text can_data can_bss < <(sizes "$can_lib")
 read -r cal_text cal_data cal_bss < <(sizes "$work/wc_arm_calibration.o")
 read -r fw_text fw_data fw_bss < <(sizes "$work/firmware.elf")
 read -r base_text base_data base_bss < <(sizes "$work/baseline.elf")
+read -r xfw_text xfw_data xfw_bss < <(sizes "$work/firmware_xcp.elf")
+# The XCP slave: its object in the CAN layer, and the firmware with it minus the one without
+# (of which the table1 image, its reference page, in .wc_calibration).
+read -r xcp_text xcp_data xcp_bss < <(${prefix}size "$can_lib" | awk '$6 == "wc_xcp.c.obj" { print $1, $2, $3 }')
+[ -n "${xcp_text:-}" ] || { echo "check_arm: FAIL: no wc_xcp.c.obj in $can_lib" >&2; exit 1; }
+xcp_flash=$(((xfw_text + xfw_data) - (fw_text + fw_data)))
+xcp_ram=$(((xfw_data + xfw_bss) - (fw_data + fw_bss)))
+xcp_image=$(${prefix}size -A "$work/firmware_xcp.elf" | awk '$1 == ".wc_calibration" { print $2 }')
+xcp_image=${xcp_image:-0}
 flash_total=$((lib_text + lib_data + cal_text + cal_data))
 ram_static=$((lib_data + lib_bss + cal_data + cal_bss))
 linked_flash=$(((fw_text + fw_data) - (base_text + base_data)))
@@ -198,10 +249,16 @@ symsize() {
 state_bytes=$(symsize wc_probe_sizeof_clutch)
 model_bytes=$(symsize wc_probe_sizeof_model)
 max_iterations=$(symsize wc_probe_inverse_max_iterations)
+xcp_state=$(symsize wc_probe_sizeof_xcp)
+xcp_page=$(symsize wc_probe_sizeof_xcp_page)
+xcp_sets=$(symsize wc_probe_sizeof_xcp_sets)
+xcp_daq=$(symsize wc_probe_sizeof_xcp_daq)
+xcp_rx=$(symsize wc_probe_sizeof_xcp_rx)
+xcp_rest=$((xcp_state - xcp_page - xcp_sets - xcp_daq - xcp_rx))
 
 # Stack: own frames (.su) summed along the call graph (.ci); functions outside
 # the library (expf and what it calls) from their prologues in the linked image.
-stack_report=$(python3 - "$build/src/model/CMakeFiles/wetclutch.dir:$build/src/can/CMakeFiles/wetclutch_can.dir" "$work/firmware.elf" "${prefix}objdump" include <<'EOF'
+stack_report=$(python3 - "$build/src/model/CMakeFiles/wetclutch.dir:$build/src/can/CMakeFiles/wetclutch_can.dir" "$work/firmware_xcp.elf" "${prefix}objdump" include <<'EOF'
 import glob, os, re, subprocess, sys
 objdir, elf, objdump, incdir = sys.argv[1:5]
 
@@ -302,6 +359,8 @@ worst_public=$(awk -F'\t' '$1 == "public" { print $4; exit }' <<<"$stack_report"
 worst_public_name=$(awk -F'\t' '$1 == "public" { print $2; exit }' <<<"$stack_report")
 worst_public_path=$(awk -F'\t' '$1 == "public" { print $6; exit }' <<<"$stack_report")
 step_stack=$(awk -F'\t' '$2 == "wc_clutch_step" { print $4 }' <<<"$stack_report")
+xcp_step_stack=$(awk -F'\t' '$2 == "wc_xcp_step" { print $4 " B (" $6 ")" }' <<<"$stack_report")
+xcp_init_stack=$(awk -F'\t' '$2 == "wc_xcp_init" { print $4 " B (" $6 ")" }' <<<"$stack_report")
 
 # Goals (issue 19): model + LUT flash, worst stack of a public entry point, state per clutch.
 flash_goal=10240
@@ -325,9 +384,15 @@ arm-none-eabi-gcc $gcc_version, preset $preset: -mcpu=cortex-m4 -mthumb -mfloat-
 | static RAM, library + LUT | $ram_static B | state lives in the caller's wc_clutch_t |
 | CAN layer (libwetclutch_can.a: codec, E2E, frame loop) text/data/bss | $can_text / $can_data / $can_bss B | optional; every frame's pack and unpack |
 | flash of a linked firmware (clutch init+step, loop init+step), minus an empty one | $linked_flash B | gc-sections; includes newlib expf (used at init only) and memset |
+| XCP slave (wc_xcp.o in the CAN layer) text/data/bss | $xcp_text / $xcp_data / $xcp_bss B | optional (wc_xcp.h) |
+| flash of the same firmware with the XCP slave (init, receive, step), minus without | $xcp_flash B, of which the table1 image (the reference page, .wc_calibration) $xcp_image B | gc-sections; the slave + the image's decode and checks |
+| RAM of that firmware, minus without | $xcp_ram B | its static wc_xcp_t |
+| XCP slave state, sizeof(wc_xcp_t) | $xcp_state B: working page $xcp_page, two decoded sets $xcp_sets, DAQ tables $xcp_daq, rx ring $xcp_rx, the rest $xcp_rest | the caller's |
 | state per clutch, sizeof(wc_clutch_t) | $state_bytes B (of which wc_model_t $model_bytes B) | $(goal "$state_bytes" "$state_goal") |
 | worst stack, public entry point | $worst_public B, $worst_public_name | $(goal "$worst_public" "$stack_goal") |
 | stack of wc_clutch_step | $step_stack B | |
+| stack of wc_xcp_step | $xcp_step_stack | after wc_loop_step, not nested in it |
+| stack of wc_xcp_init | $xcp_init_stack | |
 | inverse: WC_INVERSE_MAX_ITERATIONS | $max_iterations | compile-time bound on the Newton steps |
 
 Worst chain: $worst_public_path

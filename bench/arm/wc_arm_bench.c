@@ -49,6 +49,19 @@
  * table1 (row wc_cal_image_load:table1_full; one sample: the same bytes
  * every time).
  *
+ * The XCP on CAN slave (wc_xcp.h) in a calibration session: the loop on the
+ * committed image in torque control, wc_xcp_step right after each
+ * wc_loop_step, a master's command frames (wc_arm_xcp.c) received one a
+ * period; rows wc_xcp_step:idle (connected, nothing to do),
+ * :daq_8_signals (one DAQ list, 8 floats of wc_loop_t.last in 8 ODTs,
+ * configured by FREE_DAQ .. START_STOP_SYNCH), :checksum_page
+ * (BUILD_CHECKSUM over the page) and :download_page_check (a DOWNLOAD of the
+ * shift PI gain: the whole-page check and wc_loop_recalibrate), the last two
+ * with the DAQ list running; every response, DAQ frame's bytes, checksum and
+ * accepted page is checked. Then the page check's parts
+ * (wc_cal_image_decode:page, wc_loop_recalibrate:table1_full) and the CRC-32
+ * of the largest checksum block (wc_image_crc32:4096B).
+ *
  * Output lines (parsed by scripts/bench_arm.sh):
  *   EMPTY <instructions>        window overhead, subtracted from every figure
  *   NOP <instructions>          1000 nops (must read 1000)
@@ -67,10 +80,12 @@
 #include <wetclutch_can/wc_cal_image.h>
 #include <wetclutch_can/wc_can_signals.h>
 #include <wetclutch_can/wc_loop.h>
+#include <wetclutch_can/wc_xcp.h>
 
 #include "wc_arm_calibration.h"
 #include "wc_arm_io.h"
 #include "wc_arm_naive.h"
+#include "wc_arm_xcp.h"
 #include "wc_table1_cal_image.h"  /* lut/: table1 + shift_1_2_full, in the .wc_calibration section */
 #include "wc_test_fixtures.h"  /* tests/c: the shift scenario of the C tests */
 
@@ -138,6 +153,13 @@ typedef enum {
     ROW_SHIFT_STEP_ADAPT,
     ROW_SHIFT_END_ADAPT,
     ROW_CAL_IMAGE_LOAD,
+    ROW_XCP_IDLE,
+    ROW_XCP_DAQ,
+    ROW_XCP_CHECKSUM_PAGE,
+    ROW_XCP_DOWNLOAD_CHECK,
+    ROW_CRC32_MAX_BLOCK,
+    ROW_CAL_IMAGE_DECODE,
+    ROW_LOOP_RECALIBRATE,
     ROWS
 } row_t;
 
@@ -147,6 +169,13 @@ static const char *const row_name[ROWS] = {
     [ROW_SHIFT_STEP_ADAPT] = "wc_shift_step:inertia_adaptive",
     [ROW_SHIFT_END_ADAPT] = "wc_shift_step:end_adaptive",
     [ROW_CAL_IMAGE_LOAD] = "wc_cal_image_load:table1_full",
+    [ROW_XCP_IDLE] = "wc_xcp_step:idle",
+    [ROW_XCP_DAQ] = "wc_xcp_step:daq_8_signals",
+    [ROW_XCP_CHECKSUM_PAGE] = "wc_xcp_step:checksum_page",
+    [ROW_XCP_DOWNLOAD_CHECK] = "wc_xcp_step:download_page_check",
+    [ROW_CRC32_MAX_BLOCK] = "wc_image_crc32:4096B",
+    [ROW_CAL_IMAGE_DECODE] = "wc_cal_image_decode:page",
+    [ROW_LOOP_RECALIBRATE] = "wc_loop_recalibrate:table1_full",
     [ROW_CLUTCH_STEP_FILM] = "wc_clutch_step:film",
     [ROW_CLUTCH_STEP_FILM_LAG] = "wc_clutch_step:film_lag",
     [ROW_INVERSE_SOLVE] = "wc_inverse:solve",
@@ -222,6 +251,14 @@ typedef struct {
     wc_cal_set_t *cal_set;
     wc_cal_image_status_t cal_image_status;
     bool shift_ended;
+    wc_xcp_t *xcp;
+    wc_can_frame_t xcp_tx[WC_XCP_TX_FRAMES];
+    uint32_t xcp_frames;
+    const uint8_t *payload;                  /* wc_cal_image_decode's */
+    const uint8_t *crc_data;                 /* wc_image_crc32's, crc_length bytes */
+    uint32_t crc_length;
+    uint32_t crc32;
+    wc_cal_error_t cal_error;
 } bench_ctx_t;
 
 typedef void (*thunk_t)(void *ctx);
@@ -308,6 +345,26 @@ THUNK(thunk_cal_image_load)
 {
     bench_ctx_t *c = ctx;
     c->cal_image_status = wc_cal_image_load(wc_table1_cal_image, sizeof wc_table1_cal_image, c->cal_set);
+}
+THUNK(thunk_xcp_step)
+{
+    bench_ctx_t *c = ctx;
+    c->xcp_frames = wc_xcp_step(c->xcp, true, c->xcp_tx);
+}
+THUNK(thunk_crc32)
+{
+    bench_ctx_t *c = ctx;
+    c->crc32 = wc_image_crc32(c->crc_data, c->crc_length);
+}
+THUNK(thunk_cal_image_decode)
+{
+    bench_ctx_t *c = ctx;
+    c->cal_image_status = wc_cal_image_decode(c->payload, c->cal_set);
+}
+THUNK(thunk_loop_recalibrate)
+{
+    bench_ctx_t *c = ctx;
+    c->cal_error = wc_loop_recalibrate(c->loop, &c->cal_set->clutch, &c->cal_set->loop);
 }
 THUNK(thunk_crc8)
 {
@@ -730,6 +787,191 @@ static void bench_loop_shift(const wc_calibration_t *cal, row_t row)
     wc_arm_puts(" ms\n");
 }
 
+/* ------------------------------------------------------------------------ */
+/* The XCP slave (wc_xcp.h) in a calibration session                        */
+
+/* The loop runs on the committed image (table1 + shift_1_2_full) in torque
+ * control at one operating point; the XCP slave steps right after it, with
+ * the image's payload as its reference page. One master command a period at
+ * most: a master waits for each response (no block mode). */
+#define XCP_SLIP_rpm 750.0f
+#define XCP_THETA_degC 80.0f
+#define XCP_REQUEST_Nm 100.0f
+#define XCP_SETTLE_PERIODS 32u    /* the loop out of its start-up safe state (E2E sync, recovery) */
+#define XCP_MEASURED_PERIODS 64u  /* samples of the idle and DAQ rows */
+#define XCP_CHECKSUMS 4u
+#define XCP_DOWNLOADS 8u          /* the gain changed and changed back, 4 times */
+#define XCP_KP_SCALE 1.01f
+
+static wc_xcp_t xcp;
+static wc_cal_set_t xcp_loop_set;     /* the loop's calibration: the committed image */
+static wc_cal_set_t xcp_scratch_set;  /* the master's view of the page; the decode row's set */
+static uint8_t xcp_scratch_page[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
+static uint8_t crc_block[WC_XCP_CHECKSUM_MAX_BYTES];
+static uint8_t xcp_alive;
+
+/* One control period: the loop's two input frames queued and the loop
+ * stepped, then the master's command (NULL: none) received, then
+ * wc_xcp_step, measured into row unless row is ROWS. False when a command
+ * is not answered by a positive response as the step's first frame. */
+static bool xcp_period(const wc_can_frame_t *command, row_t row)
+{
+    queue_frames(XCP_SLIP_rpm, XCP_THETA_degC, XCP_REQUEST_Nm, xcp_alive);
+    xcp_alive = wc_e2e_counter_next(xcp_alive);
+    thunk_loop_step(&ctx);
+    if ((command != NULL) && !wc_xcp_receive(&xcp, command)) { return false; }
+    if (row < ROWS) {
+        record(row, measure(thunk_xcp_step, &ctx));
+    } else {
+        thunk_xcp_step(&ctx);
+    }
+    return (command == NULL) || ((ctx.xcp_frames >= 1u) && (ctx.xcp_tx[0].data[0] == WC_XCP_PID_RES));
+}
+
+/* The step's frames from first on are the DAQ list's 8 ODTs (PIDs 0..7),
+ * each carrying its signal's bytes as the loop holds them after its step,
+ * the first after the timestamp. */
+static bool xcp_daq_frames_ok(uint32_t first)
+{
+    if (ctx.xcp_frames != first + WC_ARM_XCP_DAQ_SIGNALS) { return false; }
+    for (uint32_t i = 0u; i < WC_ARM_XCP_DAQ_SIGNALS; ++i) {
+        const wc_can_frame_t *f = &ctx.xcp_tx[first + i];
+        const uint8_t *signal = (const uint8_t *)&loop + wc_arm_xcp_signal_offset(i);
+        const uint32_t pos = (i == 0u) ? 3u : 1u;
+        if ((f->id != WC_CAN_XCP_RESPONSE_FRAME_ID) || (f->data[0] != (uint8_t)i) ||
+            (memcmp(&f->data[pos], signal, 4u) != 0)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* What a master computes from the A2L to set the shift PI gain to
+ * reference kp x scale: the bytes of the page that change (*length, at
+ * most 4: one float) and their offset in the page. */
+static uint32_t xcp_kp_bytes(const uint8_t *reference, float scale, uint8_t bytes[4], uint32_t *length)
+{
+    *length = 0u;
+    if (wc_cal_image_decode(reference, &xcp_scratch_set).result != (uint32_t)WC_CAL_IMAGE_OK) { return 0u; }
+    xcp_scratch_set.shift.kp_Nm_per_rad_s *= scale;
+    wc_cal_image_encode(&xcp_scratch_set, xcp_scratch_page);
+    uint32_t first = 0u;
+    for (uint32_t i = 0u; i < wc_cal_image_payload_bytes; ++i) {
+        if (xcp_scratch_page[i] == xcp.working_page[i]) { continue; }
+        if (*length == 0u) { first = i; }
+        if (i - first >= 4u) {  /* more than one float changed */
+            *length = 0u;
+            return 0u;
+        }
+        *length = i - first + 1u;
+    }
+    for (uint32_t i = 0u; i < *length; ++i) { bytes[i] = xcp_scratch_page[first + i]; }
+    return first;
+}
+
+static void bench_xcp(void)
+{
+    const uint8_t *reference = &wc_table1_cal_image[WC_IMAGE_HEADER_BYTES];
+    const wc_xcp_config_t config = WC_XCP_CONFIG_DEFAULT;
+    if ((wc_cal_image_load(wc_table1_cal_image, sizeof wc_table1_cal_image, &xcp_loop_set).result !=
+         (uint32_t)WC_CAL_IMAGE_OK) ||
+        (wc_loop_init(&loop, &xcp_loop_set.clutch, &xcp_loop_set.loop, XCP_THETA_degC) != WC_CAL_OK) ||
+        !wc_xcp_init(&xcp, &loop, reference, &config)) {
+        fail("xcp: the image, wc_loop_init or wc_xcp_init");
+        return;
+    }
+    ctx.loop = &loop;
+    ctx.xcp = &xcp;
+    xcp_alive = 0u;
+    const wc_can_frame_t connect = wc_arm_xcp_connect();
+    bool ok = xcp_period(&connect, ROWS);
+    for (uint32_t k = 0u; k < XCP_SETTLE_PERIODS; ++k) { ok = xcp_period(NULL, ROWS) && ok; }
+    const uint32_t safe_steps = loop.counters.safe_steps;
+
+    /* Connected, no command, no DAQ. */
+    for (uint32_t k = 0u; k < XCP_MEASURED_PERIODS; ++k) {
+        ok = xcp_period(NULL, ROW_XCP_IDLE) && (ctx.xcp_frames == 0u) && ok;
+    }
+    if (!ok) { fail("xcp: CONNECT refused, or an idle step sent a frame"); }
+
+    /* The DAQ list configured by its commands, one a period, then sampled. */
+    wc_can_frame_t setup[WC_ARM_XCP_DAQ_SETUP_FRAMES];
+    const uint32_t setup_frames = wc_arm_xcp_daq_setup(config.loop_base, setup);
+    for (uint32_t i = 0u; i < setup_frames; ++i) {
+        if (!xcp_period(&setup[i], ROWS)) {
+            wc_arm_puts("XCP command ");
+            wc_arm_put_u32(i);
+            wc_arm_puts(" of the DAQ setup: response PID ");
+            wc_arm_put_u32(ctx.xcp_tx[0].data[0]);
+            wc_arm_puts(", error ");
+            wc_arm_put_u32(ctx.xcp_tx[0].data[1]);
+            wc_arm_puts("\n");
+            fail("xcp: the DAQ configuration was refused");
+            return;
+        }
+    }
+    ok = true;
+    for (uint32_t k = 0u; k < XCP_MEASURED_PERIODS; ++k) {
+        ok = xcp_period(NULL, ROW_XCP_DAQ) && xcp_daq_frames_ok(0u) && ok;
+    }
+    if (!ok) { fail("xcp: a DAQ step did not send the list's 8 ODTs with the loop's values"); }
+
+    /* BUILD_CHECKSUM over the whole page, the DAQ list running. */
+    const wc_can_frame_t set_mta_page = wc_arm_xcp_set_mta(config.cal_base);
+    const wc_can_frame_t checksum = wc_arm_xcp_build_checksum(wc_cal_image_payload_bytes);
+    for (uint32_t k = 0u; k < XCP_CHECKSUMS; ++k) {
+        ok = xcp_period(&set_mta_page, ROWS) && xcp_period(&checksum, ROW_XCP_CHECKSUM_PAGE) &&
+             (wc_image_get_u32(&ctx.xcp_tx[0].data[4]) == wc_image_crc32(xcp.working_page, wc_cal_image_payload_bytes)) &&
+             xcp_daq_frames_ok(1u) && ok;
+    }
+    if (!ok) { fail("xcp: BUILD_CHECKSUM of the page"); }
+
+    /* DOWNLOAD of the shift PI gain, scaled and back: each step checks the
+     * whole page and gives it to the loop; the DAQ list running. */
+    const float kp_reference = xcp_loop_set.shift.kp_Nm_per_rad_s;
+    for (uint32_t k = 0u; k < XCP_DOWNLOADS; ++k) {
+        const float scale = ((k % 2u) == 0u) ? XCP_KP_SCALE : 1.0f;
+        uint8_t bytes[4];
+        uint32_t length = 0u;
+        const uint32_t offset = xcp_kp_bytes(reference, scale, bytes, &length);
+        const wc_can_frame_t set_mta = wc_arm_xcp_set_mta(config.cal_base + offset);
+        const wc_can_frame_t download = wc_arm_xcp_download(bytes, length);
+        const uint32_t accepted = xcp.status.pages_accepted;
+        ok = (length > 0u) && xcp_period(&set_mta, ROWS) && xcp_period(&download, ROW_XCP_DOWNLOAD_CHECK) &&
+             (xcp.status.pages_accepted == accepted + 1u) && (xcp.status.page_result == 0u) &&
+             (loop.config.shift != NULL) && (loop.config.shift->kp_Nm_per_rad_s >= kp_reference * scale) &&
+             (loop.config.shift->kp_Nm_per_rad_s <= kp_reference * scale) && xcp_daq_frames_ok(1u) && ok;
+    }
+    if (!ok) { fail("xcp: a DOWNLOAD of the gain was not checked, accepted and given to the loop"); }
+    if (loop.counters.safe_steps != safe_steps) { fail("xcp: the loop went to its safe state in the session"); }
+
+    /* The largest BUILD_CHECKSUM block's CRC (no region is that large: the
+     * CRC-32 a block of WC_XCP_CHECKSUM_MAX_BYTES would cost). */
+    for (uint32_t i = 0u; i < WC_XCP_CHECKSUM_MAX_BYTES; ++i) { crc_block[i] = (uint8_t)(i * 131u); }
+    ctx.crc_data = crc_block;
+    ctx.crc_length = WC_XCP_CHECKSUM_MAX_BYTES;
+    record(ROW_CRC32_MAX_BLOCK, measure(thunk_crc32, &ctx));
+
+    /* The page check's two parts: the decode with its checks, and the loop's
+     * recalibration (wc_model_init: the clutch check again, the shift check again). */
+    ctx.payload = xcp.working_page;
+    ctx.cal_set = &xcp_scratch_set;
+    record(ROW_CAL_IMAGE_DECODE, measure(thunk_cal_image_decode, &ctx));
+    if (ctx.cal_image_status.result != (uint32_t)WC_CAL_IMAGE_OK) { fail("xcp: wc_cal_image_decode of the page"); }
+    record(ROW_LOOP_RECALIBRATE, measure(thunk_loop_recalibrate, &ctx));
+    if (ctx.cal_error != WC_CAL_OK) { fail("xcp: wc_loop_recalibrate"); }
+
+    wc_arm_puts("XCP session: ");
+    wc_arm_put_u32(xcp.status.commands);
+    wc_arm_puts(" commands, ");
+    wc_arm_put_u32(xcp.status.daq_frames);
+    wc_arm_puts(" DAQ frames, ");
+    wc_arm_put_u32(xcp.status.pages_accepted);
+    wc_arm_puts(" pages accepted, sizeof(wc_xcp_t) ");
+    wc_arm_put_u32((uint32_t)sizeof(wc_xcp_t));
+    wc_arm_puts(" B\n");
+}
+
 static uint32_t median_of(row_t row)
 {
     return (sample_count[row] == 0u) ? 0u : samples[row][(sample_count[row] - 1u) / 2u];
@@ -798,6 +1040,7 @@ int main(void)
         bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_FILM, false, ROW_SHIFT_STEP_FILM);
         bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_ADAPT, true, ROW_SHIFT_END_ADAPT);
         bench_loop_shift(wc_arm_identified_calibration, ROW_LOOP_STEP_SHIFT_FILM);
+        bench_xcp();
 
         wc_arm_puts("GRID ");
         wc_arm_put_u32((uint32_t)GRID_POINTS);
