@@ -59,8 +59,9 @@
  * right after wc_loop_step and after the port has handed the step's frames
  * (VfsCommand first) to its transmit queue, so that XCP never delays or
  * displaces a control frame; wc_xcp_init before the interrupt is enabled.
- * The cost of one wc_xcp_step is bounded: at most WC_XCP_RX_CAPACITY
- * commands, one page check, WC_XCP_DAQ_FRAMES_PER_STEP frames (README and
+ * The cost of one wc_xcp_step is bounded: one command (a master waits for
+ * each response; more queued frames wait for the next steps), one page
+ * check, WC_XCP_DAQ_FRAMES_PER_STEP frames (README and
  * bench/arm_ceilings.txt give the instruction counts). */
 #ifndef WC_XCP_H
 #define WC_XCP_H
@@ -78,8 +79,8 @@
 #define WC_XCP_ODTS 24u                  /* ODTs over all lists (PIDs 0..23) */
 #define WC_XCP_ODT_ENTRIES 96u           /* ODT entries over all lists */
 #define WC_XCP_DAQ_FRAMES_PER_STEP 12u   /* DAQ frames sent per control step at most */
-/* a response or error per command, a page event, the DAQ frames and an overload event */
-#define WC_XCP_TX_FRAMES (WC_XCP_RX_CAPACITY + 2u + WC_XCP_DAQ_FRAMES_PER_STEP)
+/* the command's response or error, a page event, the DAQ frames and an overload event */
+#define WC_XCP_TX_FRAMES (3u + WC_XCP_DAQ_FRAMES_PER_STEP)
 #define WC_XCP_CHECKSUM_MAX_BYTES 4096u  /* BUILD_CHECKSUM block size limit (a step's bounded cost) */
 #define WC_XCP_ID_BYTES 96u
 
@@ -206,7 +207,7 @@ bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payloa
  * false, counting rx_overflows, when the ring is full. */
 bool wc_xcp_receive(wc_xcp_t *xcp, const wc_can_frame_t *frame);
 
-/* Process the queued commands, check a changed working page once (and give
+/* Process the oldest queued command, check a changed working page once (and give
  * it to the loop), and, when control_step is true (the loop stepped in this
  * iteration), sample the running DAQ lists. Writes the frames to send to
  * out (responses first, then DAQ) and returns their count. */

@@ -428,7 +428,8 @@ static uint32_t copy_cal_page(wc_xcp_t *x, const uint8_t *cmd)
     if ((cmd[2] >= PAGES) || (cmd[4] >= PAGES)) { return WC_XCP_ERR_PAGE_NOT_VALID; }
     if (cmd[4] != 0u) { return WC_XCP_ERR_WRITE_PROTECTED; }  /* the reference page is flash */
     if (cmd[2] == 1u) {
-        x->page_dirty = copy_bytes(x->working_page, x->reference_page, wc_cal_image_payload_bytes) || x->page_dirty;
+        const bool changed = copy_bytes(x->working_page, x->reference_page, wc_cal_image_payload_bytes);
+        x->page_dirty = (changed && (x->status.ecu_page == 0u)) || x->page_dirty;  /* checked when the ECU uses it */
     }
     return XCP_OK;
 }
@@ -454,7 +455,9 @@ static uint32_t download(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc)
     uint8_t *dst = NULL;
     const uint32_t found = resolve(x, x->mta, 0u, length, true, &dst);
     if (found != XCP_OK) { return found; }
-    x->page_dirty = copy_bytes(dst, &cmd[2], length) || x->page_dirty;
+    const bool changed = copy_bytes(dst, &cmd[2], length);
+    /* a page the controller does not use is checked when SET_CAL_PAGE switches to it */
+    x->page_dirty = (changed && (x->status.ecu_page == 0u)) || x->page_dirty;
     x->mta += length;
     return XCP_OK;
 }
@@ -628,7 +631,7 @@ uint32_t wc_xcp_step(wc_xcp_t *xcp, bool control_step, wc_can_frame_t out[WC_XCP
     uint32_t n = 0u;
     const uint32_t tail = xcp->rx_tail;
     WC_MEMORY_BARRIER();
-    for (uint32_t k = 0u; (k < WC_XCP_RX_CAPACITY) && (xcp->rx_head != tail); ++k) {
+    if (xcp->rx_head != tail) {  /* one command a step: the step's cost is that of the costliest command */
         const wc_can_frame_t *in = &xcp->rx[xcp->rx_head & (WC_XCP_RX_CAPACITY - 1u)];
         if (command(xcp, in, &out[n])) { ++n; }
         xcp->rx_head++;
