@@ -46,10 +46,11 @@ def tcu() -> Path:
 # in turn by one worker (they would only queue for the one guest on two), handed out first; every other
 # module is a group of its own (its fixtures, a replay or the shift matrix, run once), the longest first
 # (LONGEST_FIRST, as measured on a 2-core machine), so the other worker's work ends with the guest's.
-SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
+SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner", "test_xcp_session",
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc", "test_adaptation_study",
                 "test_adaptation_reference"}
-VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner"}
+VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
+                "test_xcp_session"}
 VCAN_TESTS = {"test_vcan_shift_equals_in_process"}
 LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_adaptation_study",
                  "test_adaptation_reference",
