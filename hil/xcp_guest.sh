@@ -3,9 +3,9 @@
 # interface exists (natively, or inside the guest of hil/vcan_run.sh):
 #   bash hil/xcp_guest.sh DIR [--iface vcan0] [--tcu PATH] [--daq-seconds S]
 # DIR holds input.log (the TCU's inputs, played in a loop by canplayer), cal.img (the calibration image
-# wc_tcu starts from) and addresses.json (the A2L's addresses, tools/wetclutch/hil/xcp_session.py). While
-# wc_tcu --xcp runs (frame clock) and candump captures VfsCommand and the XCP frames, pyxcp runs the
-# session (python -m wetclutch.hil.xcp_session). Output in DIR: result.json (the session), capture.log,
+# wc_tcu starts from) and plan.json (the A2L's addresses and the image's bytes there,
+# tools/wetclutch/hil/xcp_session.py). While wc_tcu --xcp runs (frame clock) and candump captures
+# ClutchSensors, VfsCommand and the XCP frames, pyxcp runs the session (hil/xcp_master.py). Output in DIR: result.json (the session), capture.log,
 # stats.json and tcu.txt (wc_tcu), session.txt (the master's messages). Exits with the session's code.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,7 +21,7 @@ while [ $# -gt 0 ]; do
     *) die "unknown option '$1'" ;;
   esac
 done
-for f in input.log cal.img addresses.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
+for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
 [ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
 # Socket buffers for the master's and candump's sockets: 8 DAQ frames a millisecond may arrive faster than an
 # emulated CPU runs Python; they wait in the kernel, none is dropped (where the system permits it).
@@ -36,8 +36,8 @@ sleep 0.3
 canplayer -l i -I input.log "$iface=$iface" &
 play=$!
 rc=0
-PYTHONPATH="$repo/tools" "$repo/.venv/bin/python" -m wetclutch.hil.xcp_session --addresses addresses.json \
-  --image cal.img --out result.json --iface "$iface" --daq-seconds "$daq_seconds" > session.txt 2>&1 || rc=$?
+"$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" \
+  --daq-seconds "$daq_seconds" > session.txt 2>&1 || rc=$?
 kill "$play" 2>/dev/null; wait "$play" 2>/dev/null
 tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?
 if [ "$tcu_rc" -ne 0 ]; then echo "xcp_guest: wc_tcu failed (exit $tcu_rc), see $dir/tcu.txt" >&2; [ "$rc" -ne 0 ] || rc=$tcu_rc; fi

@@ -1,49 +1,17 @@
-"""A calibration engineer's XCP session against ``wc_tcu --xcp`` on a live SocketCAN interface, with masters
-and parsers nobody here wrote: pyxcp (XCP on CAN over python-can) and pya2ldb (the A2L). DESIGN 13.
-
-    python -m wetclutch.hil.xcp_session --addresses A2L.json --image FILE.img --out RESULT.json
-        [--iface vcan0] [--daq-seconds 5]
-
-A2L.json: the A2L's characteristics, measurements and memory segments as pya2ldb reads them
-(``read_a2l`` on the host, written by ``write_addresses``): the guest (an emulated CPU, where a Python
-import costs tens of seconds) imports only pyxcp and python-can.
-
-Runs where the interface exists (natively, or in the guest of hil/vcan_run.sh) while wc_tcu runs and a log
-plays its inputs (tests/python/test_xcp_session.py sets that up). It records what it saw, the checks are the
-test's: connect and identity, the checksum of the calibration page against the image, every characteristic
-read back at its A2L address against the image, a new holding margin downloaded, an invalid one refused, a
-DAQ of 8 signals at the 1 ms event, malformed frames and out-of-region addresses, a DAQ overload,
-disconnect. The bus is captured by candump beside it: the test reads VfsCommand there."""
+"""The host's side of the XCP session against ``wc_tcu --xcp`` (DESIGN 13): the A2L read by pya2ldb, the
+plan the guest's master follows (hil/xcp_master.py: addresses and the bytes the image holds at each
+characteristic), and the run on vcan (hil/xcp_guest.sh through hil/vcan_run.sh)."""
 from __future__ import annotations
 
-import argparse
 import json
-import struct
-import threading
-import time
-import zlib
+import os
+import subprocess
 from pathlib import Path
-
-import can
 
 from ..calibration import image_layout
 from ..util import image as image_format
 
-XCP_COMMAND_ID, XCP_RESPONSE_ID = 0x7F0, 0x7F1   # hil/wetclutch.dbc
-DAQ_SIGNALS = ("current_mA", "pressure_model_Pa", "force_command_N", "contact_force_N", "theta_degC",
-               "model_torque_Nm", "slip_rad_s", "torque_request_Nm")
-
-
-def _master(iface: str):
-    from pyxcp.config import create_application_from_config, set_application
-    from pyxcp.master import Master
-    app = create_application_from_config({
-        "Transport": {"CAN": {"interface": "socketcan", "channel": iface, "can_id_master": XCP_COMMAND_ID,
-                              "can_id_slave": XCP_RESPONSE_ID, "max_dlc_required": False}},
-        "General": {"disable_error_handling": True}}, log_level=30)
-    app.transport.timeout = 0.5
-    set_application(app)   # pyxcp's DAQ processor asks for the application (else it parses sys.argv)
-    return Master("can", config=app)
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def read_a2l(path: Path) -> dict:
@@ -58,222 +26,24 @@ def read_a2l(path: Path) -> dict:
     return {"characteristics": chars, "measurements": meas, "segments": segments}
 
 
-class _Samples:
-    """DAQ samples as pyxcp decodes them: (slave timestamp, values) per sample."""
-
-    def __init__(self, names):
-        from pyxcp.daq_stim import DaqOnlinePolicy
-
-        outer = self
-
-        class Policy(DaqOnlinePolicy):
-            def initialize(self):
-                pass
-
-            def finalize(self):
-                pass
-
-            def on_daq_list(self, daq_list, timestamp0, timestamp1, payload):
-                outer.rows.append((int(timestamp1), [float(v) for v in payload]))
-
-        self.rows: list = []
-        self.names = names
-        self.policy_class = Policy
-
-
-def _u32(xcp, address: int) -> int:
-    return struct.unpack("<I", bytes(xcp.shortUpload(4, address)))[0]
-
-
-def _f32(xcp, address: int) -> float:
-    return struct.unpack("<f", bytes(xcp.shortUpload(4, address)))[0]
-
-
-def _error_code(call) -> int | None:
-    """The XCP error code a command is answered with, None when it succeeds."""
-    from pyxcp.types import XcpResponseError
-    try:
-        call()
-    except XcpResponseError as e:
-        return int(e.get_error_code())
-    return None
-
-
-def _raw(bus: can.BusABC, data: bytes, wait_s: float = 0.2, **kw) -> list[bytes]:
-    """Send one raw frame on the XCP command id and collect the slave's answers for wait_s."""
-    bus.send(can.Message(arbitration_id=XCP_COMMAND_ID, data=data, is_extended_id=False, **kw))
-    got, end = [], time.monotonic() + wait_s
-    while time.monotonic() < end:
-        m = bus.recv(0.02)
-        if m is not None and m.arbitration_id == XCP_RESPONSE_ID and not m.is_extended_id:
-            got.append(bytes(m.data))
-    return got
-
-
-def write_addresses(a2l: Path, out: Path) -> dict:
+def write_plan(a2l: Path, image: Path, out: Path) -> dict:
+    """The master's plan: each characteristic's A2L address and the 4 bytes the image holds there (an
+    array's first element), each measurement's address, the memory segments."""
     desc = read_a2l(a2l)
-    Path(out).write_text(json.dumps(desc, indent=1))
-    return desc
+    payload = image_format.read_image(Path(image).read_bytes(), image_layout.MAGIC, image_layout.VERSION,
+                                      image_layout.payload_bytes(), what=str(image))
+    base = desc["segments"]["calibration"][0]
+    chars = {name: (address, payload[address - base:address - base + 4].hex())
+             for name, (address, _deposit, _kind) in desc["characteristics"].items()}
+    plan = {"characteristics": chars, "measurements": desc["measurements"], "segments": desc["segments"]}
+    Path(out).write_text(json.dumps(plan, indent=1))
+    return plan
 
 
-def run_session(addresses: Path, image_path: Path, iface: str, daq_seconds: float, result: dict) -> dict:
-    """Fills result as it goes (a failure leaves what was seen before it)."""
-    desc = json.loads(Path(addresses).read_text())
-    chars, meas = desc["characteristics"], desc["measurements"]
-    cal_base, cal_size = desc["segments"]["calibration"]
-    payload = image_format.read_image(Path(image_path).read_bytes(), image_layout.MAGIC, image_layout.VERSION,
-                                      image_layout.payload_bytes())
-    fields = {f.name: f for f in image_layout.FIELDS}
-    margin = fields["clutch.holding_margin"]
-    margin_address = chars["clutch.holding_margin"][0]
-    with _master(iface) as xcp:
-        t = time.monotonic()
-        connect = xcp.connect()
-        result["connect"] = {"max_cto": connect.maxCto, "max_dto": connect.maxDto, "seconds": time.monotonic() - t,
-                             "cal_pag": bool(connect.resource.calpag), "daq": bool(connect.resource.daq)}
-        status = xcp.getStatus()
-        result["daq_running_at_connect"] = bool(status.sessionStatus.daqRunning)
-        idents = {}
-        for kind in (0, 1):
-            gid = xcp.getId(kind)
-            idents[kind] = bytes(xcp.pull(gid.length)).decode("ascii") if gid.length else ""
-        result["identity"], result["a2l_name"] = idents[0], idents[1]
-        xcp.setMta(cal_base)
-        result["checksum"] = int(xcp.buildChecksum(cal_size).checksum)
-        result["checksum_image"] = zlib.crc32(payload)
-        # every characteristic at its A2L address against the image (arrays: their first element)
-        mismatches = []
-        for name, (address, _deposit, _kind) in chars.items():
-            f = fields[name]
-            got = bytes(xcp.shortUpload(4, address))
-            want = payload[f.offset:f.offset + 4]
-            if got != want:
-                mismatches.append((name, got.hex(), want.hex()))
-        result["characteristics_read"] = len(chars)
-        result["characteristic_mismatches"] = mismatches
-        result["holding_margin_image"] = struct.unpack("<f", payload[margin.offset:margin.offset + 4])[0]
-        result["holding_margin_read"] = _f32(xcp, margin_address)
-        # a new holding margin: downloaded, checked, used at the next control step
-        time.sleep(0.3)
-        new_margin = 0.5
-        xcp.setMta(margin_address)
-        xcp.download(struct.pack("<f", new_margin))
-        result["download_margin"] = new_margin
-        time.sleep(0.3)
-        result["after_download"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
-                                    "accepted": _u32(xcp, meas["xcp_pages_accepted"][0]),
-                                    "margin": _f32(xcp, margin_address)}
-        # an invalid margin (above its limit): written into the page, the page refused, control unaffected
-        xcp.setMta(margin_address)
-        xcp.download(struct.pack("<f", 5.0))
-        time.sleep(0.3)
-        result["after_invalid"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
-                                   "page_error": _u32(xcp, meas["xcp_page_error"][0]),
-                                   "rejected": _u32(xcp, meas["xcp_pages_rejected"][0]),
-                                   "margin_in_page": _f32(xcp, margin_address)}
-        xcp.setMta(margin_address)
-        xcp.download(struct.pack("<f", new_margin))   # the page is valid again
-        time.sleep(0.3)
-        result["after_restore"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0])}
-        # DAQ: 8 signals at the control step's event for daq_seconds
-        result["daq"] = _daq(xcp, meas, daq_seconds)
-        # malformed and out-of-region commands: error packets, nothing else
-        result["errors"] = {
-            "short_upload_outside": _error_code(lambda: xcp.shortUpload(4, 0x00500000)),
-            "short_upload_straddling": _error_code(lambda: xcp.shortUpload(4, cal_base + cal_size - 2)),
-            "download_measurement": _error_code(lambda: (xcp.setMta(meas["current_mA"][0]),
-                                                         xcp.download(b"\0\0\0\0"))),
-            "upload_too_long": _error_code(lambda: (xcp.setMta(cal_base), xcp.upload(8))),
-            "checksum_too_long": _error_code(lambda: (xcp.setMta(cal_base), xcp.buildChecksum(1 << 20))),
-            "copy_to_reference": _error_code(lambda: xcp.copyCalPage(0, 0, 0, 1)),
-            "cal_page_invalid": _error_code(lambda: xcp.setCalPage(0x01, 0, 7)),
-        }
-        result["overload"] = _overload(xcp, meas)
-        result["counters"] = {name: _u32(xcp, meas[name][0]) for name in
-                              ("xcp_errors", "xcp_ignored", "xcp_daq_overloads", "xcp_pages_accepted",
-                               "xcp_pages_rejected", "loop_deadline_misses", "loop_steps", "loop_safe_steps")}
-        xcp.disconnect()
-    result["disconnected"] = True
-    # frames pyxcp would never send, on a socket of our own (pyxcp's would queue their answers as its own)
-    with can.Bus(interface="socketcan", channel=iface,
-                 can_filters=[{"can_id": XCP_RESPONSE_ID, "can_mask": 0x7FF}]) as bus:
-        raw = {"before_connect": _raw(bus, bytes([0xFD]))}   # GET_STATUS while disconnected: no answer
-        raw["connect"] = _raw(bus, bytes([0xFF, 0x00]))
-        for name, data in (("unknown_command", bytes([0xC9])), ("short_set_mta", bytes([0xF6, 0, 0])),
-                           ("empty", b""), ("download_dlc_short", bytes([0xF0, 4, 1, 2])),
-                           ("upload_zero", bytes([0xF5, 0])), ("daq_ptr_unallocated", bytes([0xE2, 0, 9, 0, 0, 0])),
-                           ("write_daq_without_ptr", bytes([0xE1, 0xFF, 4, 0, 0, 0, 0x10, 0])),
-                           ("synch", bytes([0xFC])), ("disconnect", bytes([0xFE]))):
-            raw[name] = _raw(bus, data)
-        raw["remote_frame"] = _raw(bus, b"", is_remote_frame=True)
-        result["raw"] = {k: [b.hex() for b in v] for k, v in raw.items()}
-    return result
-
-
-def _daq(xcp, meas: dict, seconds: float) -> dict:
-    from pyxcp.daq_stim import DaqList
-    samples = _Samples(DAQ_SIGNALS)
-    daq_list = DaqList("signals", 0, False, True, [(n, meas[n][0], 0, "F32") for n in DAQ_SIGNALS])
-    policy = samples.policy_class([daq_list])
-    xcp.transport.policy = policy
-    policy.xcp_master = xcp
-    misses_before = _u32(xcp, meas["loop_deadline_misses"][0])
-    steps_before = _u32(xcp, meas["loop_steps"][0])
-    policy.setup()
-    policy.start()
-    time.sleep(seconds + 0.2)   # START_STOP_SYNCH's answer and STOP's take a few steps each
-    policy.stop()
-    time.sleep(0.1)
-    steps_after = _u32(xcp, meas["loop_steps"][0])
-    misses_after = _u32(xcp, meas["loop_deadline_misses"][0])
-    # pyxcp gives the slave's timestamp in ns (ticks x GET_DAQ_RESOLUTION_INFO's unit): one tick a step
-    stamps = [round(ts / 1e6) for ts, _ in samples.rows]
-    gaps = sum(1 for a, b in zip(stamps, stamps[1:]) if (b - a) % 65536 != 1) if stamps else 0
-    lost = sum(((b - a) % 65536) - 1 for a, b in zip(stamps, stamps[1:])) if stamps else 0
-    return {"signals": list(DAQ_SIGNALS), "samples": len(stamps), "gaps": gaps, "lost": lost,
-            "steps_over_setup_and_run": steps_after - steps_before, "deadline_misses": misses_after - misses_before,
-            "first": stamps[:1], "last": stamps[-1:],
-            "current_mA": [row[1][0] for row in samples.rows[:: max(1, len(samples.rows) // 50)]]}
-
-
-def _overload(xcp, meas: dict) -> dict:
-    """A DAQ list of more ODTs than a step may send: it is never sampled, counted, EV_DAQ_OVERLOAD sent."""
-    before = _u32(xcp, meas["xcp_daq_overloads"][0])
-    odts = 16
-    xcp.freeDaq()
-    xcp.allocDaq(1)
-    xcp.allocOdt(0, odts)
-    for j in range(odts):
-        xcp.allocOdtEntry(0, j, 1)
-    for j in range(odts):
-        xcp.setDaqPtr(0, j, 0)
-        xcp.writeDaq(0xFF, 4, 0, meas["current_mA"][0])
-    xcp.setDaqListMode(0x10, 0, 0, 1, 0)
-    xcp.startStopDaqList(0x02, 0)
-    xcp.startStopSynch(0x01)
-    time.sleep(0.2)
-    xcp.startStopSynch(0x00)
-    return {"odts": odts, "overloads": _u32(xcp, meas["xcp_daq_overloads"][0]) - before}
-
-
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--addresses", required=True, help="the A2L's addresses (write_addresses)")
-    p.add_argument("--image", required=True)
-    p.add_argument("--out", required=True)
-    p.add_argument("--iface", default="vcan0")
-    p.add_argument("--daq-seconds", type=float, default=5.0)
-    args = p.parse_args(argv)
-    result: dict = {}
-    try:
-        run_session(Path(args.addresses), Path(args.image), args.iface, args.daq_seconds, result)
-    except Exception as e:   # the session's record says where it stopped; the test shows it
-        result["failed"] = f"{type(e).__name__}: {e}"
-        raise
-    finally:
-        Path(args.out).write_text(json.dumps(result, indent=1, default=str))
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+def run_on_vcan(work: Path, tcu: Path, daq_seconds: float = 5.0) -> int:
+    """hil/xcp_guest.sh on work (input.log, cal.img, plan.json) on vcan: natively, in the serving guest
+    (VCAN_SERVER) or in a guest of its own. Returns its exit code."""
+    env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
+    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(work), "--", "bash",
+           str(ROOT / "hil" / "xcp_guest.sh"), str(work), "--tcu", str(tcu), "--daq-seconds", str(daq_seconds)]
+    return subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL).returncode
