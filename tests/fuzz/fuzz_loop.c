@@ -23,7 +23,8 @@
  *     c & 3 == 1  a frame; with the timer clock, a tick too if c bit 2
  *     c & 3 == 2  a frame and a tick
  *     c & 3 == 3  a port event (RX dropped / bus error / TX failed /
- *                 deadline missed) with a count byte
+ *                 deadline missed) with a count byte; with c bit 4 an XCP
+ *                 command frame instead (below)
  *   c bits 3-5 choose the frame id (ClutchSensors x3, TorqueRequest x3,
  *   BenchMeasurement, other); "other" reads a 16-bit id, and a byte of
  *   format (bit 7 set: DLC = low nibble 0..15, flags = bits 4-6) follows
@@ -31,6 +32,25 @@
  *   signal). c bits 6-7 are the fault in "make valid" mode: 0 none, 1 alive
  *   counter advanced by a fuzzed nibble (one more byte: 0 repeats, 2 loses a
  *   frame, ...), 2 a wrong CRC (one more byte), 3 the frame as fuzzed.
+ *
+ * XCP (wc_xcp.h, DESIGN 13): a wc_xcp_t beside the loop, started at the
+ * input's first XCP frame, its reference page the loop's calibration
+ * (wc_cal_set_from + wc_cal_image_encode; a fuzzed loop configuration
+ * outside the image's limits: no slave, an XCP record is a port event). As in
+ * wc_tcu, every frame of the XcpCommand id goes to wc_xcp_receive (the loop
+ * iterates without it) and wc_xcp_step runs after every wc_loop_iterate
+ * (control_step = the loop stepped) into its own output array, except after
+ * an XCP record with c bit 6 that did not step the loop (its frame waits in
+ * the ring: several in a row overflow it). An XCP
+ * record (c & 3 == 3, c bit 4; c bit 5: a tick with it) is a selector byte
+ * s, then [a format byte as above if s bit 6], then 7 data bytes after the
+ * command code: s & 0x1F picks the code from xcp_codes (past its end: the
+ * first data byte is the code); s bit 5 "aimed": an address (SET_MTA,
+ * SHORT_UPLOAD, WRITE_DAQ) is put inside or just past a region (data byte 4
+ * picks it, bytes 5-6 the offset), extension 0; a DOWNLOAD writes 4 bytes,
+ * the working page's float at the MTA times 1 + (int8)byte 2 / 128 (so that
+ * pages the check accepts, with other values, reach the loop); SET_CAL_PAGE
+ * a valid mode and page 0/1; BUILD_CHECKSUM a block of at most 1 KiB.
  *
  * Oracle after every wc_loop_iterate (abort with a message on violation):
  *  - it returns WC_LOOP_TX_CYCLIC exactly when the clock says so (a tick, or
@@ -49,7 +69,19 @@
  *    (SNA-free, saturated at most); with adaptation the learned values stay
  *    inside their bands (wc_adapt_values_valid) after every step;
  *  - counters: frames_used + sum(rejected) + frames still queued ==
- *    frames_in; frames_out == the frames the steps returned.
+ *    frames_in; frames_out == the frames the steps returned;
+ *  - the current range, the safe state's minimum and the recovery debounce
+ *    are those of the calibration the loop uses now (an accepted XCP page
+ *    may change them);
+ *  - XCP, after every wc_xcp_step: at most WC_XCP_TX_FRAMES frames, each of
+ *    id 0x7F1, DLC 8, no flags, its PID 0xFF/0xFE/0xFD or a DAQ PID below
+ *    the allocated ODT count; after every page check (the only place a
+ *    calibration changes; wc_calibration_check is costly) the loop's
+ *    calibration passes
+ *    wc_calibration_check (and its shift calibration
+ *    wc_shift_calibration_check), its control period and shift control's
+ *    presence are the ones it started with; the loop's own frames are in
+ *    their own array (VfsCommand first, checked above).
  * At the end one more tick empties the ring and the counters must add up
  * with nothing queued. */
 #include <stdio.h>
@@ -59,6 +91,7 @@
 #include <wetclutch/wetclutch.h>
 #include <wetclutch_can/wc_e2e.h>
 #include <wetclutch_can/wc_loop.h>
+#include <wetclutch_can/wc_xcp.h>
 
 #include "wc_fuzz_common.h"
 #include "wc_shift_1_2_shift.h"
@@ -99,6 +132,24 @@ typedef struct {
 } harness_t;
 
 static wc_loop_t loop;  /* ~1 KiB: static, not on the fuzzer's stack */
+static wc_xcp_t xcp;    /* the XCP slave beside the loop (~10 KiB) */
+static bool xcp_on;     /* wc_xcp_init accepted the loop's calibration as a page */
+static bool xcp_tried;  /* wc_xcp_init was tried (at the input's first XCP frame) */
+static uint32_t xcp_checks;  /* page checks seen (accepted + rejected): the calibration can change only there */
+static wc_cal_set_t xcp_set;
+static uint8_t xcp_reference[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
+static const wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
+static uint32_t xcp_frames;  /* statistics for WC_FUZZ_VERBOSE */
+
+/* The commands an XCP record picks (s & 0x1F); past the end the frame's first data byte is the code. */
+static const uint8_t xcp_codes[] = {
+    WC_XCP_CONNECT, WC_XCP_DISCONNECT, WC_XCP_GET_STATUS, WC_XCP_SYNCH, WC_XCP_GET_COMM_MODE_INFO, WC_XCP_GET_ID,
+    WC_XCP_SET_MTA, WC_XCP_UPLOAD, WC_XCP_SHORT_UPLOAD, WC_XCP_BUILD_CHECKSUM, WC_XCP_DOWNLOAD, WC_XCP_DOWNLOAD,
+    WC_XCP_SET_CAL_PAGE, WC_XCP_GET_CAL_PAGE, WC_XCP_GET_PAG_PROCESSOR_INFO, WC_XCP_COPY_CAL_PAGE,
+    WC_XCP_SET_DAQ_PTR, WC_XCP_WRITE_DAQ, WC_XCP_SET_DAQ_LIST_MODE, WC_XCP_START_STOP_DAQ_LIST,
+    WC_XCP_START_STOP_SYNCH, WC_XCP_GET_DAQ_CLOCK, WC_XCP_GET_DAQ_PROCESSOR_INFO, WC_XCP_GET_DAQ_RESOLUTION_INFO,
+    WC_XCP_GET_DAQ_EVENT_INFO, WC_XCP_FREE_DAQ, WC_XCP_ALLOC_DAQ, WC_XCP_ALLOC_ODT, WC_XCP_ALLOC_ODT_ENTRY,
+};
 
 static float map_u16(uint16_t u, float lo, float hi) { return lo + (hi - lo) * ((float)u / 65535.0f); }
 
@@ -188,8 +239,9 @@ static void check_counters(const harness_t *h)
 static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
     h->steps++;
-    const float i_min = cal->vfs_current_min_mA;
-    const float i_max = cal->vfs_current_max_mA;
+    const wc_calibration_t *now = loop.clutch.model.cal;  /* an accepted XCP page may have changed it */
+    const float i_min = now->vfs_current_min_mA;
+    const float i_max = now->vfs_current_max_mA;
     const float lsb_mA = 1.0f / 32.0f;  /* VfsCurrent scaling */
 
     /* the model's own output (the frame would hide a NaN as 0 mA) */
@@ -232,9 +284,9 @@ static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES]
         FZ_CHECK(safe, "timeout bits 0x%x without StatusSafeStateActive", (unsigned)cmd.status);
     }
     if (!safe) {
-        FZ_CHECK(h->fresh_run >= h->config.recovery_periods,
+        FZ_CHECK(h->fresh_run >= loop.config.recovery_periods,
                  "safe state left after %u fresh steps (recovery %u)", (unsigned)h->fresh_run,
-                 (unsigned)h->config.recovery_periods);
+                 (unsigned)loop.config.recovery_periods);
         h->control_steps++;
     } else {
         FZ_CHECK((o->current_mA == i_min) && (fabsf(cmd.vfs_current_mA - i_min) <= 0.5f * lsb_mA),
@@ -256,7 +308,124 @@ static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES]
     check_counters(h);
 }
 
-static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsigned record)
+static bool same_bits(float a, float b)
+{
+    uint32_t x;
+    uint32_t y;
+    memcpy(&x, &a, sizeof x);
+    memcpy(&y, &b, sizeof y);
+    return x == y;
+}
+
+/* wc_xcp_step after the loop's iteration, into its own array, and its oracle. */
+static void xcp_step(const harness_t *h, bool control_step, unsigned record)
+{
+    wc_can_frame_t xout[WC_XCP_TX_FRAMES];  /* exactly the contract's size: ASan sees a write past it */
+    memset(xout, 0, sizeof xout);
+    fz_context("wc_xcp_step(control_step)", record);
+    fz_ctx.iargs[0] = control_step;
+    const uint32_t n = wc_xcp_step(&xcp, control_step, xout);
+    FZ_CHECK(n <= WC_XCP_TX_FRAMES, "wc_xcp_step returned %u frames", (unsigned)n);
+    xcp_frames += n;
+    for (uint32_t i = 0u; i < n; ++i) {
+        const wc_can_frame_t *f = &xout[i];
+        FZ_CHECK((f->id == WC_CAN_XCP_RESPONSE_FRAME_ID) && (f->dlc == 8u) && (f->flags == 0u),
+                 "XCP frame %u: id 0x%x dlc %u flags %u", (unsigned)i, (unsigned)f->id, (unsigned)f->dlc,
+                 (unsigned)f->flags);
+        const uint8_t pid = f->data[0];
+        FZ_CHECK((pid == WC_XCP_PID_RES) || (pid == WC_XCP_PID_ERR) || (pid == WC_XCP_PID_EV) || (pid < xcp.odt_count),
+                 "XCP frame %u: PID 0x%02x (ODTs %u)", (unsigned)i, (unsigned)pid, (unsigned)xcp.odt_count);
+    }
+    const uint32_t checks = xcp.status.pages_accepted + xcp.status.pages_rejected;
+    if (checks == xcp_checks) { return; }  /* no page check in this step: the loop's calibration is as it was */
+    xcp_checks = checks;
+    const wc_calibration_t *now = loop.clutch.model.cal;
+    const wc_cal_error_t e = wc_calibration_check(now);
+    FZ_CHECK(e == WC_CAL_OK, "the loop runs on a calibration the check refuses: %s", wc_cal_error_name(e));
+    FZ_CHECK(same_bits(now->control_period_s, cal->control_period_s), "control period changed online: %g s",
+             (double)now->control_period_s);
+    FZ_CHECK((loop.config.shift != NULL) == h->shift, "shift control %s online",
+             (loop.config.shift != NULL) ? "switched on" : "switched off");
+    if (loop.config.shift != NULL) {
+        FZ_CHECK(wc_shift_calibration_check(loop.config.shift) == WC_SHIFT_CAL_OK,
+                 "the loop runs on a shift calibration the check refuses");
+    }
+}
+
+/* The slave, started at the input's first XCP frame (inputs without one pay nothing for it): the loop still
+ * runs on the calibration it was initialised with, the reference page's. A fuzzed loop configuration outside
+ * the image's limits (a timeout or SyncCounter 0, ...) does not decode: no slave then. */
+static bool xcp_start(const harness_t *h)
+{
+    if (!xcp_tried) {
+        xcp_tried = true;
+        xcp_on = wc_cal_set_from(&xcp_set, cal, h->config.shift, &h->config);
+        if (xcp_on) {
+            wc_cal_image_encode(&xcp_set, xcp_reference);
+            xcp_on = wc_xcp_init(&xcp, &loop, xcp_reference, &xcp_config);
+        }
+    }
+    return xcp_on;
+}
+
+/* An XCP command frame as the fuzzer describes it (see the top of the file). */
+static void build_xcp_frame(fz_reader_t *r, wc_can_frame_t *f)
+{
+    const uint8_t s = fz_u8(r);
+    memset(f, 0, sizeof *f);
+    f->id = WC_CAN_XCP_COMMAND_FRAME_ID;
+    f->dlc = 8u;
+    if ((s & 0x40u) != 0u) {
+        const uint8_t format = fz_u8(r);
+        f->dlc = (uint8_t)(format & 0x0Fu);
+        f->flags = (uint8_t)((format >> 4) & 0x07u);
+    }
+    const uint32_t pick = s & 0x1Fu;
+    uint8_t *d = f->data;
+    for (size_t i = 1u; i < sizeof f->data; ++i) { d[i] = fz_u8(r); }
+    d[0] = (pick < sizeof xcp_codes) ? xcp_codes[pick] : d[1];
+    if ((s & 0x20u) == 0u) { return; }  /* as fuzzed */
+    wc_xcp_region_t regions[WC_XCP_REGIONS];
+    wc_xcp_regions(&xcp, regions);
+    switch (d[0]) {
+    case WC_XCP_SET_MTA:
+    case WC_XCP_SHORT_UPLOAD:
+    case WC_XCP_WRITE_DAQ: {
+        const wc_xcp_region_t *g = &regions[d[4] & 3u];
+        const uint32_t address = g->base + (uint32_t)(d[5] | (d[6] << 8)) % (g->size + 8u);
+        d[3] = 0u;
+        for (uint32_t i = 0u; i < 4u; ++i) { d[4u + i] = (uint8_t)(address >> (8u * i)); }
+        if (d[0] == WC_XCP_WRITE_DAQ) { d[1] = 0xFFu; d[2] = (uint8_t)(d[2] % 8u); }
+        break;
+    }
+    case WC_XCP_DOWNLOAD: {
+        const uint32_t offset = xcp.mta - regions[0].base;
+        const float factor = 1.0f + (float)(int8_t)d[2] / 128.0f;
+        float v = factor;
+        if ((xcp.mta >= regions[0].base) && (offset + 4u <= regions[0].size)) {
+            memcpy(&v, &xcp.working_page[offset], sizeof v);
+            v *= factor;
+        }
+        d[1] = 4u;
+        memcpy(&d[2], &v, sizeof v);
+        break;
+    }
+    case WC_XCP_SET_CAL_PAGE:
+        d[1] = (uint8_t)(1u + d[1] % 3u);
+        d[2] = 0u;
+        d[3] &= 1u;
+        break;
+    case WC_XCP_BUILD_CHECKSUM:
+        d[6] = 0u;
+        d[7] = 0u;
+        d[5] &= 3u;
+        break;
+    default:
+        break;
+    }
+}
+
+static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsigned record, bool xcp_waits)
 {
     wc_can_frame_t out[WC_LOOP_TX_FRAMES];
     memset(out, 0, sizeof out);
@@ -268,7 +437,7 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
     const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
                                    (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
-    const bool adaptive = h->shift && (h->config.shift->adaptation == 1u);
+    const bool adaptive = h->shift && (loop.config.shift->adaptation == 1u);
     const uint32_t most = !h->shift ? WC_LOOP_TX_CYCLIC : (adaptive ? WC_LOOP_TX_FRAMES : WC_LOOP_TX_CYCLIC + 1u);
     FZ_CHECK(expected ? ((n >= WC_LOOP_TX_CYCLIC) && (n <= most)) : (n == 0u),
              "wc_loop_iterate returned %u, expected %u..%u", (unsigned)n, expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u,
@@ -290,7 +459,7 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
         }
     }
     if (adaptive) {
-        FZ_CHECK(wc_adapt_values_valid(&loop.adapt.values, h->config.shift), "learned values outside their bands");
+        FZ_CHECK(wc_adapt_values_valid(&loop.adapt.values, loop.config.shift), "learned values outside their bands");
     }
     h->frames_out += n;
     if (n >= WC_LOOP_TX_CYCLIC) {
@@ -298,6 +467,7 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     } else {
         check_counters(h);
     }
+    if (xcp_on && ((n > 0u) || !xcp_waits)) { xcp_step(h, n > 0u, record); }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -330,22 +500,38 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_ctx.iargs[0] = options;
     fz_ctx.iargs[1] = (long)h.config.recovery_periods;
     FZ_CHECK(wc_loop_init(&loop, cal, &h.config, theta_start) == WC_CAL_OK, "wc_loop_init failed");
+    xcp_on = false;
+    xcp_tried = false;
+    xcp_frames = 0u;
+    xcp_checks = 0u;
 
     for (unsigned record = 1u; (record <= MAX_RECORDS) && fz_more(&r); ++record) {
         const uint8_t c = fz_u8(&r);
         switch (c & 3u) {
         case 0:
-            iterate(&h, NULL, true, record);
+            iterate(&h, NULL, true, record, false);
             break;
         case 1:
         case 2: {
             wc_can_frame_t f;
             build_frame(&h, &r, c, &f);
             const bool tick = ((c & 3u) == 2u) || ((h.clock == WC_LOOP_CLOCK_TIMER) && ((c & 0x04u) != 0u));
-            iterate(&h, &f, tick, record);
+            if ((f.id == WC_CAN_XCP_COMMAND_FRAME_ID) && xcp_start(&h)) {  /* as wc_tcu: the slave's, not the loop's */
+                (void)wc_xcp_receive(&xcp, &f);
+                iterate(&h, NULL, tick, record, false);
+            } else {
+                iterate(&h, &f, tick, record, false);
+            }
             break;
         }
         default: {
+            if (((c & 0x10u) != 0u) && xcp_start(&h)) {  /* an XCP command frame */
+                wc_can_frame_t f;
+                build_xcp_frame(&r, &f);
+                (void)wc_xcp_receive(&xcp, &f);  /* a full ring is counted */
+                iterate(&h, NULL, (c & 0x20u) != 0u, record, (c & 0x40u) != 0u);
+                break;
+            }
             const uint8_t count = fz_u8(&r);
             fz_context("port event", record);
             switch ((c >> 2) & 3u) {
@@ -359,7 +545,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         }
     }
-    iterate(&h, NULL, true, MAX_RECORDS + 1u);  /* empties the ring */
+    iterate(&h, NULL, true, MAX_RECORDS + 1u, false);  /* empties the ring */
     FZ_CHECK(loop.rx_tail == loop.rx_head, "frames left in the ring after a step");
     if (verbose) {
         fprintf(stderr,
@@ -372,6 +558,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 (unsigned)loop.counters.rejected[WC_REJECT_FORMAT],
                 (unsigned)loop.counters.rejected[WC_REJECT_IMPLAUSIBLE],
                 (unsigned)loop.counters.rejected[WC_REJECT_OVERFLOW], (unsigned)loop.counters.rejected[WC_REJECT_SYNC]);
+        if (xcp_on) {
+            fprintf(stderr,
+                    "fuzz_loop: xcp commands %u (errors %u, ignored %u, lost %u), frames out %u, pages accepted %u "
+                    "rejected %u (last %u/%u), daq samples %u overloads %u\n",
+                    (unsigned)xcp.status.commands, (unsigned)xcp.status.errors, (unsigned)xcp.status.ignored,
+                    (unsigned)xcp.status.rx_overflows, (unsigned)xcp_frames, (unsigned)xcp.status.pages_accepted,
+                    (unsigned)xcp.status.pages_rejected, (unsigned)xcp.status.page_result,
+                    (unsigned)xcp.status.page_error, (unsigned)xcp.status.daq_samples,
+                    (unsigned)xcp.status.daq_overloads);
+        }
     }
     return 0;
 }

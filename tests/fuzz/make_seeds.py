@@ -243,8 +243,84 @@ def loop_overflow():
     return b
 
 
+# XCP records (fuzz_loop.c): c = 3 | 0x10 | (0x20: a tick with it) | (0x40: no wc_xcp_step after it), the selector (index into xcp_codes,
+# 0x20 "aimed"), 7 data bytes after the command code.
+XCP = {name: i for i, name in enumerate([
+    "CONNECT", "DISCONNECT", "GET_STATUS", "SYNCH", "GET_COMM_MODE_INFO", "GET_ID", "SET_MTA", "UPLOAD",
+    "SHORT_UPLOAD", "BUILD_CHECKSUM", "DOWNLOAD", "DOWNLOAD2", "SET_CAL_PAGE", "GET_CAL_PAGE",
+    "GET_PAG_PROCESSOR_INFO", "COPY_CAL_PAGE", "SET_DAQ_PTR", "WRITE_DAQ", "SET_DAQ_LIST_MODE",
+    "START_STOP_DAQ_LIST", "START_STOP_SYNCH", "GET_DAQ_CLOCK", "GET_DAQ_PROCESSOR_INFO", "GET_DAQ_RESOLUTION_INFO",
+    "GET_DAQ_EVENT_INFO", "FREE_DAQ", "ALLOC_DAQ", "ALLOC_ODT", "ALLOC_ODT_ENTRY"])}
+HOLDING_MARGIN_OFFSET = 112  # src/can/generated/wc_cal_image_layout.h
+
+
+def rec_xcp(name, *data, aimed=False, tick=False, wait=False):
+    return bytes([3 | 0x10 | (0x20 if tick else 0) | (0x40 if wait else 0), XCP[name] | (0x20 if aimed else 0)]) + \
+        bytes(list(data) + [0] * (7 - len(data)))
+
+
+def xcp_session(commands, periods=80):
+    """'make valid' + 'plausible' engagement, one XCP command after each period's frames."""
+    b = bytes([0x04 | 0x08])
+    profile = engagement_profile(periods)
+    for k, (slip, oil, housing, req, mode) in enumerate(profile):
+        b += bytes([1 | (SEL_SENSORS << 3), 0x00]) + u16_of(slip, -8000, 8000) + u16_of(oil, -40, 200) + \
+            u16_of(housing, -40, 200)
+        b += bytes([1 | 0x04 | (SEL_REQUEST << 3), 0x00]) + u16_of(req, 0, 2000) + bytes([mode])
+        if k < len(commands):
+            b += commands[k]
+    return b
+
+
+def xcp_seeds():
+    mta_margin = rec_xcp("SET_MTA", 0, 0, 0, 0, *struct.pack("<H", HOLDING_MARGIN_OFFSET), aimed=True)
+    downloads = xcp_session([
+        rec_xcp("CONNECT"), rec_xcp("GET_STATUS"), mta_margin,
+        rec_xcp("DOWNLOAD", 0, 64, aimed=True),            # margin x 1.5: accepted
+        rec_xcp("GET_STATUS"), mta_margin,
+        rec_xcp("DOWNLOAD", 0, 0x80, aimed=True),          # margin x 0: refused (EV_USER)
+        mta_margin, rec_xcp("DOWNLOAD", 4, 0x9A, 0x99, 0x99, 0x3E),  # 0.3 raw: accepted again
+        rec_xcp("SET_CAL_PAGE", 0, 0, 1, aimed=True),      # a page 1 access
+        rec_xcp("SET_CAL_PAGE", 0x01, 0, 1),               # the ECU on the reference page
+        rec_xcp("SET_CAL_PAGE", 0x03, 0, 0),               # back on the working page
+        rec_xcp("COPY_CAL_PAGE", 0, 1, 0, 0),
+        rec_xcp("SET_MTA", 0, 0, 0, 0, 0, aimed=True), rec_xcp("BUILD_CHECKSUM", 0, 0, 0, 0x40, 0x04, aimed=True),
+        rec_xcp("SHORT_UPLOAD", 7, 0, 0, 1, 8, 0, aimed=True), rec_xcp("UPLOAD", 7),
+        rec_xcp("GET_ID", 0), rec_xcp("UPLOAD", 7), rec_xcp("DISCONNECT"),
+    ])
+    daq = xcp_session([
+        rec_xcp("CONNECT"), rec_xcp("FREE_DAQ"), rec_xcp("ALLOC_DAQ", 0, 2, 0), rec_xcp("ALLOC_ODT", 0, 0, 0, 2),
+        rec_xcp("ALLOC_ODT", 0, 1, 0, 13),                     # more ODTs than a step's frames: overload
+        rec_xcp("ALLOC_ODT_ENTRY", 0, 0, 0, 0, 2), rec_xcp("ALLOC_ODT_ENTRY", 0, 0, 0, 1, 1),
+        rec_xcp("SET_DAQ_PTR", 0, 0, 0, 0, 0),
+        rec_xcp("WRITE_DAQ", 0xFF, 4, 0, 1, 0x40, 0, aimed=True),  # 4 bytes of the loop
+        rec_xcp("WRITE_DAQ", 0xFF, 1, 0, 2, 0x10, 0, aimed=True),  # 1 byte of the slave's status
+        rec_xcp("SET_DAQ_PTR", 0, 0, 0, 1, 0), rec_xcp("WRITE_DAQ", 0xFF, 4, 0, 1, 0x80, 0, aimed=True),
+        rec_xcp("SET_DAQ_LIST_MODE", 0x10, 0, 0, 0, 0, 1), rec_xcp("SET_DAQ_LIST_MODE", 0x10, 1, 0, 0, 0, 3),
+        rec_xcp("START_STOP_DAQ_LIST", 2, 0, 0), rec_xcp("START_STOP_DAQ_LIST", 2, 1, 0),
+        rec_xcp("START_STOP_SYNCH", 1), rec_xcp("GET_DAQ_CLOCK"), rec_xcp("GET_DAQ_PROCESSOR_INFO"),
+        rec_xcp("GET_DAQ_RESOLUTION_INFO"), rec_xcp("GET_DAQ_EVENT_INFO", 0, 0, 0),
+        rec_xcp("SET_DAQ_PTR", 0, 0, 0, 0, 0),                 # a running list: ERR_DAQ_ACTIVE
+        rec_xcp("START_STOP_DAQ_LIST", 0, 1, 0), rec_xcp("START_STOP_SYNCH", 0),
+    ])
+    errors = xcp_session([
+        rec_xcp("GET_STATUS"),                                  # before CONNECT: ignored
+        rec_xcp("CONNECT"), bytes([3 | 0x10, 31, 0xC0]) + bytes(6),  # an unknown code
+        bytes([3 | 0x10, XCP["SET_MTA"] | 0x40, 0x84]) + bytes(7),   # DLC 4: too short
+        bytes([3 | 0x10, XCP["GET_STATUS"] | 0x40, 0x98]) + bytes(7),  # extended flag: ignored
+        rec_xcp("UPLOAD", 8), rec_xcp("SHORT_UPLOAD", 4, 0, 0, 0, 0x3E, 0x04, aimed=True),  # past the page's end
+        rec_xcp("SET_MTA", 0, 0, 0, 1, 0, 0, aimed=True), rec_xcp("DOWNLOAD", 2, 1, 2),  # the loop: read-only
+        rec_xcp("COPY_CAL_PAGE", 0, 0, 0, 1), rec_xcp("SET_CAL_PAGE", 0x03, 0, 2),
+        rec_xcp("ALLOC_ODT", 0, 0, 0, 1), rec_xcp("FREE_DAQ"), rec_xcp("ALLOC_DAQ", 0, 9, 0),
+    ] + [rec_xcp("GET_STATUS")] * 6)                            # then a full ring between two steps
+    # six commands between two steps: the ring (4) overflows, then ticks answer the rest one a step
+    errors += b"".join(rec_xcp("GET_COMM_MODE_INFO", wait=True) for _ in range(6)) + bytes([0] * 5)
+    return {"xcp_downloads": downloads, "xcp_daq": daq, "xcp_errors": errors}
+
+
 def loop_seeds():
     return {
+        **xcp_seeds(),
         "engagement_timer": loop_engagement(False),
         "engagement_frame_clock": loop_engagement(True),
         "engagement_bench": loop_engagement(False, bench=True),
