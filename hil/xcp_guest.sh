@@ -23,9 +23,6 @@ while [ $# -gt 0 ]; do
 done
 for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
 [ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
-# Socket buffers for the master's and candump's sockets: 8 DAQ frames a millisecond may arrive faster than an
-# emulated CPU runs Python; they wait in the kernel, none is dropped (where the system permits it).
-sysctl -q -w net.core.rmem_max=67108864 net.core.rmem_default=67108864 2>/dev/null || true
 cd "$dir"
 candump -L "$iface,110:7FF,120:7FF,7F0:7FE" > capture.log &   # ClutchSensors, VfsCommand, XCP
 dump=$!

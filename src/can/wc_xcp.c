@@ -51,9 +51,15 @@ static void put16(uint8_t *dst, uint32_t value)
 static uint32_t get16(const uint8_t *src) { return (uint32_t)src[0] | ((uint32_t)src[1] << 8); }
 
 /* Byte copies without the C library's memcpy (the core links only memset),
- * bounded by their length: at most a calibration page. Returns whether any
- * byte changed. */
-static bool copy_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
+ * bounded by their length: at most a calibration page. */
+static void copy_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
+{
+    for (uint32_t i = 0u; i < length; ++i) { dst[i] = src[i]; }
+}
+
+/* The same into the working page: returns whether any byte changed (a
+ * page written with the bytes it holds needs no check). */
+static bool write_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
 {
     bool changed = false;
     for (uint32_t i = 0u; i < length; ++i) {
@@ -123,7 +129,7 @@ bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payloa
     xcp->config = *config;
     xcp->loop = loop;
     xcp->reference_page = reference_payload;
-    (void)copy_bytes(xcp->working_page, reference_payload, wc_cal_image_payload_bytes);
+    copy_bytes(xcp->working_page, reference_payload, wc_cal_image_payload_bytes);
     xcp->loop_set = -1;
     (void)copy_text(&xcp->id[ID_IDENT], config->ident, ID_A2L - ID_IDENT);
     (void)copy_text(&xcp->id[ID_A2L], config->a2l_name, ID_EVENT - ID_A2L);
@@ -351,7 +357,7 @@ static uint32_t daq_sample(wc_xcp_t *x, wc_can_frame_t *out, wc_can_frame_t *eve
             for (uint32_t e = 0u; e < o->entries; ++e) {
                 const wc_xcp_odt_entry_t *entry = &x->entries[o->first_entry + e];
                 if ((entry->size == 0u) || (pos + entry->size > MAX_DTO)) { continue; }  /* not written */
-                (void)copy_bytes(&f->data[pos], entry->src, entry->size);
+                copy_bytes(&f->data[pos], entry->src, entry->size);
                 pos += entry->size;
             }
         }
@@ -428,7 +434,7 @@ static uint32_t copy_cal_page(wc_xcp_t *x, const uint8_t *cmd)
     if ((cmd[2] >= PAGES) || (cmd[4] >= PAGES)) { return WC_XCP_ERR_PAGE_NOT_VALID; }
     if (cmd[4] != 0u) { return WC_XCP_ERR_WRITE_PROTECTED; }  /* the reference page is flash */
     if (cmd[2] == 1u) {
-        const bool changed = copy_bytes(x->working_page, x->reference_page, wc_cal_image_payload_bytes);
+        const bool changed = write_bytes(x->working_page, x->reference_page, wc_cal_image_payload_bytes);
         x->page_dirty = (changed && (x->status.ecu_page == 0u)) || x->page_dirty;  /* checked when the ECU uses it */
     }
     return XCP_OK;
@@ -442,7 +448,7 @@ static uint32_t upload(wc_xcp_t *x, uint32_t address, uint32_t extension, uint32
     uint8_t *src = NULL;
     const uint32_t found = resolve(x, address, extension, length, false, &src);
     if (found != XCP_OK) { return found; }
-    (void)copy_bytes(&res[1], src, length);
+    copy_bytes(&res[1], src, length);
     x->mta = address + length;
     return XCP_OK;
 }
@@ -455,7 +461,7 @@ static uint32_t download(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc)
     uint8_t *dst = NULL;
     const uint32_t found = resolve(x, x->mta, 0u, length, true, &dst);
     if (found != XCP_OK) { return found; }
-    const bool changed = copy_bytes(dst, &cmd[2], length);
+    const bool changed = write_bytes(dst, &cmd[2], length);
     /* a page the controller does not use is checked when SET_CAL_PAGE switches to it */
     x->page_dirty = (changed && (x->status.ecu_page == 0u)) || x->page_dirty;
     x->mta += length;
@@ -610,7 +616,7 @@ static bool command(wc_xcp_t *x, const wc_can_frame_t *in, wc_can_frame_t *res)
     frame_init(res, WC_XCP_PID_RES);
     const uint32_t needed = command_length(in->data[0]);
     uint8_t cmd[MAX_CTO] = { 0u };
-    (void)copy_bytes(cmd, in->data, in->dlc);  /* bytes past the DLC read as 0, never as old data */
+    copy_bytes(cmd, in->data, in->dlc);  /* bytes past the DLC read as 0, never as old data */
     uint32_t result = WC_XCP_ERR_CMD_UNKNOWN;
     if (needed != 0u) { result = (in->dlc < needed) ? WC_XCP_ERR_CMD_SYNTAX : dispatch(x, cmd, in->dlc, res->data); }
     x->status.commands++;
@@ -618,7 +624,7 @@ static bool command(wc_xcp_t *x, const wc_can_frame_t *in, wc_can_frame_t *res)
         const uint8_t max_block[4] = { res->data[4], res->data[5], res->data[6], res->data[7] };
         frame_init(res, WC_XCP_PID_ERR);
         res->data[1] = (uint8_t)result;
-        if (result == WC_XCP_ERR_OUT_OF_RANGE) { (void)copy_bytes(&res->data[4], max_block, sizeof max_block); }
+        if (result == WC_XCP_ERR_OUT_OF_RANGE) { copy_bytes(&res->data[4], max_block, sizeof max_block); }
         x->status.errors++;
     }
     return true;
