@@ -4,18 +4,19 @@
 # started by hil/vcan_run.sh):
 #   bash hil/replay_guest.sh LOG OUTDIR [--iface vcan0] [--log-iface NAME]
 #                            [--frame-runs N] [--timer-runs N] [--tcu PATH] [--calibration NAME] [--bench]
-#                            [--theta-start DEGC]
+#                            [--theta-start DEGC] [--calibration-image FILE --image-runs N]
 # Each run: candump -L captures the bus, wc_tcu runs (frame clock: one step per
 # ClutchSensors frame; timer clock: fixed period), canplayer plays LOG with its
 # timing, wc_tcu stops when the bus has been idle for 1 s. Output per run:
-# OUTDIR/<clock><n>.log (capture), .json (wc_tcu statistics), .txt (wc_tcu stderr).
+# OUTDIR/<clock><n>.log (capture), .json (wc_tcu statistics), .txt (wc_tcu stderr); --image-runs: frame-clock
+# runs with wc_tcu --calibration-image FILE instead of --calibration, OUTDIR/image<n>.*.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 die() { echo "replay_guest: $*" >&2; exit 2; }
 [ $# -ge 2 ] || die "usage: $0 LOG OUTDIR [--iface vcan0] [--log-iface NAME] [--frame-runs N] [--timer-runs N] [--tcu PATH] [--calibration NAME] [--bench] [--theta-start DEGC]"
 log=$1 out=$2; shift 2
 iface=vcan0 log_iface="" frame_runs=2 timer_runs=1 tcu="$repo/build/host-release/src/port/wc_tcu" calibration=table1
-bench=() theta=()
+bench=() theta=() image="" image_runs=0
 while [ $# -gt 0 ]; do
   case $1 in
     --iface) iface=$2; shift 2 ;;
@@ -26,6 +27,8 @@ while [ $# -gt 0 ]; do
     --calibration) calibration=$2; shift 2 ;;
     --bench) bench=(--bench); shift ;;   # wc_tcu uses BenchMeasurement (the paper's validation)
     --theta-start) theta=(--theta-start "$2"); shift 2 ;;   # the observer's start (the log's first oil temperature)
+    --calibration-image) image=$2; shift 2 ;;
+    --image-runs) image_runs=$2; shift 2 ;;
     *) die "unknown option '$1'" ;;
   esac
 done
@@ -36,11 +39,14 @@ for tool in candump canplayer; do command -v $tool >/dev/null || die "$tool not 
 pin=""; command -v taskset >/dev/null && pin="taskset -c 0"
 mkdir -p "$out"
 
-one_run() { # clock name
+one_run() { # clock name [calibration options]
   local clock=$1 name=$2 dump_pid tcu_pid rc=0
+  shift 2
+  local cal=("$@")
+  [ ${#cal[@]} -gt 0 ] || cal=(--calibration "$calibration")
   candump -L -r 8388608 "$iface" >"$out/$name.log" &
   dump_pid=$!
-  "$tcu" --iface "$iface" --clock "$clock" --calibration "$calibration" "${bench[@]}" "${theta[@]}" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
+  "$tcu" --iface "$iface" --clock "$clock" "${cal[@]}" "${bench[@]}" "${theta[@]}" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
   tcu_pid=$!
   for _ in $(seq 100); do grep -q "clock $clock" "$out/$name.txt" 2>/dev/null && break; sleep 0.05; done
   grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill $dump_pid $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }
@@ -68,3 +74,7 @@ one_run() { # clock name
 }
 for i in $(seq "$frame_runs"); do one_run frame "frame$i"; done
 for i in $(seq "$timer_runs"); do one_run timer "timer$i"; done
+if [ "$image_runs" -gt 0 ]; then
+  [ -r "$image" ] || die "--image-runs needs a readable --calibration-image"
+  for i in $(seq "$image_runs"); do one_run frame "image$i" --calibration-image "$image"; done
+fi

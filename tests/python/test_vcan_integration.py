@@ -16,6 +16,8 @@ import numpy as np
 import pytest
 
 from frames_check import assert_frames_match_reference
+from conftest import TABLE1
+from wetclutch.calibration import cal_image
 from wetclutch.hil import replay
 from wetclutch.util import canlog
 
@@ -56,7 +58,10 @@ def replayed(tmp_path_factory, root, tcu):
     work = tmp_path_factory.mktemp("vcan")
     log = work / "input.log"
     _input_log(log)
-    replay.run_on_vcan([(log, work / "out")], frame_runs=2, timer_runs=1, tcu=tcu)
+    image = work / "table1.img"   # the same calibration as an image file (DESIGN 13)
+    cal_image.write_file(image, cal_image.build(TABLE1))
+    replay.run_on_vcan([(log, work / "out")], frame_runs=2, timer_runs=1, tcu=tcu, calibration_image=image,
+                       image_runs=1)
     return log, work / "out"
 
 
@@ -79,6 +84,15 @@ def test_frame_clock_replay_is_deterministic(replayed):
     second = replay.raw_payloads(canlog.read_log(out / "frame2.log"))
     assert len(first) == 2 * STEPS
     assert first == second
+
+
+def test_calibration_image_gives_the_same_frames(replayed):
+    """wc_tcu --calibration-image of table1 and the compiled-in table1: byte-identical output frames."""
+    _, out = replayed
+    compiled = replay.raw_payloads(canlog.read_log(out / "frame1.log"))
+    from_image = replay.raw_payloads(canlog.read_log(out / "image1.log"))
+    assert len(from_image) == 2 * STEPS
+    assert from_image == compiled
 
 
 def test_tcu_counts_frames_and_rejects(replayed):

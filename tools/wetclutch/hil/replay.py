@@ -91,9 +91,11 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 # --------------------------------------------------------------------------- running on vcan
 
 def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
-                calibration: str = "table1", bench: bool = True) -> None:
+                calibration: str = "table1", bench: bool = True, calibration_image: Path | None = None,
+                image_runs: int = 0) -> None:
     """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
-    of jobs, wc_tcu with --bench unless bench is False. Progress goes to stderr.
+    of jobs, wc_tcu with --bench unless bench is False; image_runs more frame-clock runs with
+    wc_tcu --calibration-image calibration_image (image<n>.*). Progress goes to stderr.
     Raises on failure."""
     tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
     if not tcu.is_file():
@@ -110,7 +112,9 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
         script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
                                   str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
                                   "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else []),
-                                  "--theta-start", f"{theta:.1f}"]))
+                                  "--theta-start", f"{theta:.1f}",
+                                  *(["--calibration-image", str(Path(calibration_image).resolve()), "--image-runs",
+                                     str(image_runs)] if image_runs else [])]))
     rw = [arg for d in shared for arg in ("--rwdir", str(d))]
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), *rw, "--", "bash", "-c", " && ".join(script)]
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
