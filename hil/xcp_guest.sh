@@ -23,8 +23,11 @@ while [ $# -gt 0 ]; do
 done
 for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
 [ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
+# Socket buffers: the master's Python may fall seconds behind 8 DAQ frames a millisecond on an emulated
+# CPU; the frames wait in its socket instead of being dropped (where the system permits it).
+sysctl -q -w net.core.rmem_max=67108864 net.core.rmem_default=67108864 2>/dev/null || true
 cd "$dir"
-candump -L "$iface,110:7FF,120:7FF,7F0:7FE" > capture.log &   # ClutchSensors, VfsCommand, XCP
+candump -L -r 8388608 "$iface,110:7FF,120:7FF,7F0:7FE" > capture.log &   # ClutchSensors, VfsCommand, XCP
 dump=$!
 "$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 --idle-exit 1 \
   --stats-json stats.json 2> tcu.txt &
@@ -38,7 +41,14 @@ rc=0
 kill "$play" 2>/dev/null; wait "$play" 2>/dev/null
 tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?
 if [ "$tcu_rc" -ne 0 ]; then echo "xcp_guest: wc_tcu failed (exit $tcu_rc), see $dir/tcu.txt" >&2; [ "$rc" -ne 0 ] || rc=$tcu_rc; fi
-sleep 0.2
+# candump lags behind the bus on an emulated CPU: stop it once its capture has stopped growing
+size=-1
+for _ in $(seq 600); do
+  sleep 0.25
+  new=$(stat -c %s capture.log)
+  [ "$new" = "$size" ] && break
+  size=$new
+done
 kill "$dump" 2>/dev/null; wait "$dump" 2>/dev/null
 [ "$rc" -eq 0 ] || echo "xcp_guest: the XCP session failed (exit $rc), see $dir/session.txt" >&2
 exit "$rc"
