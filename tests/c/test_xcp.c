@@ -486,12 +486,12 @@ static void test_daq_sequence_and_frames(void **state)
     /* no DAQ without a control step */
     assert_int_equal(xstep(false), 0u);
 
-    uint32_t frames_before = 0u;
     for (uint32_t k = 1u; k <= 10u; ++k) {
-        frames_before = rig.xcp.status.daq_frames;
+        const uint32_t frames_before = rig.xcp.status.daq_frames;
         assert_true(period(1000.0f - 50.0f * (float)k, 10.0f * (float)k, MODE_TORQUE));
         const bool list1 = (k % 2u) == 0u;  /* prescaler 2 */
         assert_int_equal(rig.xn, list1 ? 3u : 2u);
+        assert_int_equal(rig.xcp.status.daq_frames - frames_before, rig.xn);  /* every frame sent is counted */
         const wc_can_frame_t *f = rig.xout;
         expect_ts(&f[0], 0u);
         assert_memory_equal(&f[0].data[3], &rig.loop.last.current_mA, 4u);
