@@ -38,23 +38,18 @@ for tool in candump canplayer; do command -v $tool >/dev/null || die "$tool not 
 [ -n "$log_iface" ] || log_iface=$(awk 'NF>=3 {print $2; exit}' "$log")
 pin=""; command -v taskset >/dev/null && pin="taskset -c 0"
 mkdir -p "$out"
-# candump writes its capture to a local tmpfs, moved to OUTDIR after the run: in the QEMU guest OUTDIR is
-# the host's file system over 9p, where every line costs a round trip and candump lagged the bus by
-# seconds (2.2 s of a 9 s replay, measured in the guest alone).
-capture_dir=$(mktemp -d /dev/shm/replay_guest.XXXXXX 2>/dev/null || mktemp -d)
-trap 'rm -rf "$capture_dir"' EXIT
+. "$repo/hil/capture.sh"
 
 one_run() { # clock name [calibration options]
-  local clock=$1 name=$2 dump_pid tcu_pid rc=0
+  local clock=$1 name=$2 tcu_pid rc=0
   shift 2
   local cal=("$@")
   [ ${#cal[@]} -gt 0 ] || cal=(--calibration "$calibration")
-  candump -L -r 8388608 "$iface" >"$capture_dir/$name.log" &
-  dump_pid=$!
+  capture_start "$out/$name.log" "$iface"
   "$tcu" --iface "$iface" --clock "$clock" "${cal[@]}" "${bench[@]}" "${theta[@]}" --idle-exit 1.0 --stats-json "$out/$name.json" 2>"$out/$name.txt" &
   tcu_pid=$!
   for _ in $(seq 100); do grep -q "clock $clock" "$out/$name.txt" 2>/dev/null && break; sleep 0.05; done
-  grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill $dump_pid $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }
+  grep -q "clock $clock" "$out/$name.txt" || { cat "$out/$name.txt" >&2; kill "$capture_pid" $tcu_pid 2>/dev/null; die "wc_tcu did not start"; }
   sleep 0.2  # candump's socket is bound by now too
   # One CPU for the sender: vcan queues each frame on the sending CPU's backlog,
   # so a canplayer that migrates between CPUs can have two frames of the same
@@ -63,18 +58,7 @@ one_run() { # clock name [calibration options]
   # emulated guest under load). Pinned, the delivery order is the log's.
   $pin canplayer -I "$log" "$iface=$log_iface"
   wait $tcu_pid || rc=$?
-  # candump may lag behind the bus (slow in an emulated guest): stop it only
-  # once its capture has stopped growing, or it drops what it still queues.
-  local size=-1
-  for _ in $(seq 120); do
-    sleep 0.25
-    new=$(stat -c %s "$capture_dir/$name.log")
-    [ "$new" = "$size" ] && break
-    size=$new
-  done
-  kill $dump_pid 2>/dev/null || true
-  wait $dump_pid 2>/dev/null || true
-  mv "$capture_dir/$name.log" "$out/$name.log"
+  capture_stop
   [ "$rc" = 0 ] || { cat "$out/$name.txt" >&2; die "wc_tcu exited with $rc ($name)"; }
   echo "replay_guest: $name: $(grep -c . "$out/$name.log") frames captured" >&2
 }

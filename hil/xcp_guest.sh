@@ -27,11 +27,8 @@ for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $d
 # CPU; the frames wait in its socket instead of being dropped (where the system permits it).
 sysctl -q -w net.core.rmem_max=67108864 net.core.rmem_default=67108864 2>/dev/null || true
 cd "$dir"
-# the capture on a local tmpfs, moved to DIR at the end (DIR is the host's file system over 9p in the guest)
-capture_dir=$(mktemp -d /dev/shm/xcp_guest.XXXXXX 2>/dev/null || mktemp -d)
-trap 'rm -rf "$capture_dir"' EXIT
-candump -L -r 8388608 "$iface,110:7FF,120:7FF,7F0:7FE" > "$capture_dir/capture.log" &   # ClutchSensors, VfsCommand, XCP
-dump=$!
+. "$repo/hil/capture.sh"
+capture_start capture.log "$iface,110:7FF,120:7FF,7F0:7FE"   # ClutchSensors, VfsCommand, XCP
 "$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 --idle-exit 1 \
   --stats-json stats.json 2> tcu.txt &
 tcu_pid=$!
@@ -44,15 +41,6 @@ rc=0
 kill "$play" 2>/dev/null; wait "$play" 2>/dev/null
 tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?
 if [ "$tcu_rc" -ne 0 ]; then echo "xcp_guest: wc_tcu failed (exit $tcu_rc), see $dir/tcu.txt" >&2; [ "$rc" -ne 0 ] || rc=$tcu_rc; fi
-# candump lags behind the bus on an emulated CPU: stop it once its capture has stopped growing
-size=-1
-for _ in $(seq 600); do
-  sleep 0.25
-  new=$(stat -c %s "$capture_dir/capture.log")
-  [ "$new" = "$size" ] && break
-  size=$new
-done
-kill "$dump" 2>/dev/null; wait "$dump" 2>/dev/null
-mv "$capture_dir/capture.log" capture.log
+capture_stop 600
 [ "$rc" -eq 0 ] || echo "xcp_guest: the XCP session failed (exit $rc), see $dir/session.txt" >&2
 exit "$rc"

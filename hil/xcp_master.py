@@ -48,7 +48,7 @@ def _master(iface: str):
 class _Samples:
     """DAQ samples as pyxcp decodes them: (slave timestamp, values) per sample."""
 
-    def __init__(self, names):
+    def __init__(self):
         from pyxcp.daq_stim import DaqOnlinePolicy
 
         outer = self
@@ -64,7 +64,6 @@ class _Samples:
                 outer.rows.append((int(timestamp1), [float(v) for v in payload]))
 
         self.rows: list = []
-        self.names = names
         self.policy_class = Policy
 
 
@@ -194,7 +193,7 @@ class _Daq:
         self.xcp, self.meas = xcp, meas
         self.names = list(DAQ_SIGNALS)
         self.daq_list = DaqList("signals", 0, False, True, [(n, meas[n][0], 0, "F32") for n in DAQ_SIGNALS])
-        self.samples = _Samples(self.names)
+        self.samples = _Samples()
         self.policy = self.samples.policy_class([self.daq_list])
         xcp.transport.policy = self.policy
         self.policy.xcp_master = xcp

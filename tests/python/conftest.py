@@ -25,17 +25,22 @@ def cal():
     return calibration.load(TABLE1)
 
 
-@pytest.fixture(scope="session")
-def tcu() -> Path:
-    """The TCU program (host-release build). Missing: a skip for a developer
-    running pytest alone, a failure in CI, where scripts/test.sh builds it."""
-    path = ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
+def built_program(build: str, rel: str) -> Path:
+    """A program of a CMake preset's build (build/BUILD/REL). Missing: a skip for a developer running
+    pytest alone, a failure in CI, where scripts/test.sh builds it."""
+    path = ROOT / "build" / build / rel
     if not path.is_file():
-        message = f"{path} not built (cmake --preset host-release && cmake --build --preset host-release)"
+        message = f"{path} not built (cmake --preset {build} && cmake --build --preset {build})"
         if os.environ.get("CI"):
             pytest.fail(message)
         pytest.skip(message)
     return path
+
+
+@pytest.fixture(scope="session")
+def tcu() -> Path:
+    """The TCU program (host-release build)."""
+    return built_program("host-release", "src/port/wc_tcu")
 
 
 

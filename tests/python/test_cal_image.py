@@ -24,6 +24,7 @@ ROOT = Path(__file__).resolve().parents[2]
 if __name__ == "__main__":
     sys.path.insert(0, str(ROOT / "tools"))
 
+from conftest import built_program  # noqa: E402
 from wetclutch import cli  # noqa: E402
 from wetclutch.calibration import cal_image, image_layout as layout, shift as shift_calibration  # noqa: E402
 from wetclutch.generate import cal_image_layout  # noqa: E402
@@ -237,19 +238,9 @@ def test_show(tmp_path, capsys):
 
 # --------------------------------------------------------------------------- the programs
 
-def _program(build: str, rel: str) -> Path:
-    path = ROOT / "build" / build / rel
-    if not path.is_file():
-        message = f"{path} not built (cmake --preset {build} && cmake --build --preset {build})"
-        if os.environ.get("CI"):
-            pytest.fail(message)
-        pytest.skip(message)
-    return path
-
-
 @pytest.fixture(scope="module")
 def wc_replay() -> Path:
-    return _program("host-release", "src/host/wc_replay")
+    return built_program("host-release", "src/host/wc_replay")
 
 
 def _image(tmp_path: Path, name: str, calibration: Path, variant: str | None = None) -> Path:
