@@ -60,9 +60,9 @@ upshift  UpshiftPlant (the equations above) and initial_turbine_speed_rpm
 """
 from __future__ import annotations
 
-from .params import (DEFAULT_PLANT, DT_S, GRAVITY, NOISE_BLOCK, RANGES, RPM, SCHEMA, SUBSTEPS, PlantError,
-                     PlantParams, load_plant)
+from .params import (DEFAULTS, DEFAULT_PLANT, DT_S, GRAVITY, NOISE_BLOCK, RANGES, RPM, SCHEMA, SUBSTEPS, PlantError,
+                     OPTIONAL, PlantParams, load_plant)
 from .upshift import TRUTH_NAMES, UpshiftPlant, initial_turbine_speed_rpm
 
-__all__ = ["DEFAULT_PLANT", "DT_S", "GRAVITY", "NOISE_BLOCK", "RANGES", "RPM", "SCHEMA", "SUBSTEPS", "TRUTH_NAMES",
+__all__ = ["DEFAULTS", "DEFAULT_PLANT", "OPTIONAL", "DT_S", "GRAVITY", "NOISE_BLOCK", "RANGES", "RPM", "SCHEMA", "SUBSTEPS", "TRUTH_NAMES",
            "PlantError", "PlantParams", "UpshiftPlant", "initial_turbine_speed_rpm", "load_plant"]

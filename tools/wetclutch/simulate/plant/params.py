@@ -1,4 +1,14 @@
-"""The plant file (tools/plants/*.toml): schema, ranges, PlantParams, load_plant; the step constants (DT_S, SUBSTEPS)."""
+"""The plant file (tools/plants/*.toml): schema, ranges, PlantParams, load_plant; the step constants (DT_S, SUBSTEPS).
+
+A plant file names every parameter of SCHEMA as { value, unit, source }, except the OPTIONAL ones (the whole
+shift's: engine, off-going clutch's own VFS, on-coming fill; issue 22), which take their documented DEFAULTS
+when absent, so that a plant file written before them loads with unchanged behaviour (the fill off, the
+off-going clutch's VFS only used when the TCU drives it, the engine only when a torque request is given).
+
+A file may start with ``extends = "base.toml"`` (a path relative to the file): it then holds only what differs
+from its base, parameter by parameter (a parameter given replaces the base's whole entry; [clutch] and
+[offgoing] calibration paths stay relative to the file that names them). A base may itself extend another;
+a missing base or a loop is a PlantError naming the file and 'extends'."""
 from __future__ import annotations
 
 import math
@@ -59,7 +69,40 @@ SCHEMA: tuple[tuple[str, str, str, str], ...] = (
     ("scenario", "turbine_torque_full", "N*m", "pos"),
     ("scenario", "oil_temperature", "degC", "finite"),
     ("scenario", "seed", "1", "seed"),
+    # the whole shift (issue 22, DESIGN 14): OPTIONAL, see DEFAULTS
+    ("engine", "engine_time_constant", "s", "pos"),
+    ("engine", "engine_delay", "s", "nonneg"),
+    ("engine", "engine_torque_max", "N*m", "finite"),
+    ("engine", "engine_torque_min", "N*m", "finite"),
+    ("offgoing", "offgoing_friction_scale", "1", "pos"),
+    ("offgoing", "offgoing_vfs_gain", "Pa/mA", "pos"),
+    ("offgoing", "offgoing_vfs_time_constant", "s", "pos"),
+    ("hydraulics", "fill_volume", "m^3", "nonneg"),
+    ("hydraulics", "fill_flow_gain", "m^3/(s*Pa)", "pos"),
+    ("hydraulics", "fill_flow_max", "m^3/s", "nonneg"),
 )
+
+# The optional parameters: name -> (default value, or a function of the other values; the source recorded).
+DEFAULTS = {
+    "engine_time_constant": (0.08, "default: engine torque follows a request with a first-order lag of 80 ms "
+                             "(a mix of the fast spark path and the slow air path)"),
+    "engine_delay": (0.0, "default: no dead time"),
+    "engine_torque_max": (lambda v: 1.2 * v["turbine_torque_full"],
+                          "default: 1.2 x scenario.turbine_torque_full (headroom of a torque increase)"),
+    "engine_torque_min": (0.0, "default: a reduction down to zero torque at most (no drag torque requested)"),
+    "offgoing_friction_scale": (1.0, "default: the off-going clutch's friction as its calibration"),
+    "offgoing_vfs_gain": (lambda v: v["vfs_gain"], "default: as the on-coming clutch's VFS (hydraulics.vfs_gain)"),
+    "offgoing_vfs_time_constant": (lambda v: v["vfs_time_constant"],
+                                   "default: as the on-coming clutch's VFS (hydraulics.vfs_time_constant)"),
+    "fill_volume": (0.0, "default: 0, no fill (the plates touch at the return spring's pressure at once, "
+                    "as before issue 22)"),
+    "fill_flow_gain": (2.625e-8, "default: the nominal vehicle's (tools/plants/vehicles/nominal.toml); "
+                       "used only with fill_volume > 0"),
+    "fill_flow_max": (2.55e-4, "default: the nominal vehicle's (tools/plants/vehicles/nominal.toml); "
+                      "used only with fill_volume > 0"),
+}
+OPTIONAL = frozenset(DEFAULTS)
+
 
 # Narrower physical ranges (inclusive): (low, high).
 RANGES = {
@@ -71,6 +114,13 @@ RANGES = {
     "turbine_speed": (0.0, 8000.0),
     "oil_temperature": (-40.0, 150.0),
     "torque_estimate_bias": (-0.5, 0.5),
+    "engine_time_constant": (1e-4, 10.0),
+    "engine_delay": (0.0, 1.0),
+    "engine_torque_max": (0.0, 5000.0),
+    "engine_torque_min": (-1000.0, 5000.0),
+    "offgoing_friction_scale": (0.2, 5.0),
+    "offgoing_vfs_time_constant": (1e-4, 10.0),
+    "fill_volume": (0.0, 1e-3),
 }
 
 
@@ -115,6 +165,19 @@ class PlantParams:
     turbine_torque_full: float
     oil_temperature: float
     seed: int
+    # the whole shift (issue 22): optional in the file (DEFAULTS)
+    offgoing_cal: calibration.Calibration   # the off-going clutch ([offgoing] calibration, default [clutch]'s)
+    engine_time_constant: float
+    engine_delay: float                     # s, a whole number of periods
+    engine_torque_max: float
+    engine_torque_min: float
+    offgoing_friction_scale: float
+    offgoing_vfs_gain: float
+    offgoing_vfs_time_constant: float
+    fill_volume: float                      # m^3; 0 = no fill
+    fill_flow_gain: float                   # m^3/(s*Pa)
+    fill_flow_max: float                    # m^3/s; 0 = no limit
+    offgoing_calibration_path: str = ""
     sources: dict = field(default_factory=dict, compare=False)
     path: str = ""
 
@@ -123,14 +186,49 @@ _FIELDS = {f.name for f in fields(PlantParams)}
 assert {n for _, n, _, _ in SCHEMA} <= _FIELDS
 
 
-def load_plant(path) -> PlantParams:
-    """Read and validate a plant file (every parameter { value, unit, source }; [clutch].calibration a
-    path relative to the plant file). Raises PlantError naming the file and the parameter."""
-    path = Path(path)
+_PATH_KEYS = (("clutch", "calibration"), ("offgoing", "calibration"))
+
+
+def _read_doc(path: Path, chain: tuple) -> dict:
+    """The document of path with its extends= chain merged in (the file's own entries win); the path-valued
+    entries made absolute (relative to the file naming them)."""
     where = str(path)
     doc = read_toml(path, PlantError, "plant file")
+    for section, key in _PATH_KEYS:
+        table = doc.get(section)
+        if isinstance(table, dict) and isinstance(table.get(key), str) and table[key].strip():
+            table[key] = str((path.parent / table[key]).resolve())
+    base_entry = doc.pop("extends", None)
+    if base_entry is None:
+        return doc
+    if not isinstance(base_entry, str) or not base_entry.strip():
+        raise PlantError(f"{where}: 'extends' must be the path of a base plant file (relative to this file)")
+    base_path = (path.parent / base_entry).resolve()
+    if base_path in chain:
+        raise PlantError(f"{where}: 'extends' loop: {' -> '.join(str(c) for c in chain + (base_path,))}")
+    if not base_path.is_file():
+        raise PlantError(f"{where}: 'extends': base plant file {base_path} not found")
+    try:
+        base = _read_doc(base_path, chain + (base_path,))
+    except PlantError as e:
+        raise PlantError(f"{where}: 'extends' {base_entry!r}: {e}") from None
+    for section, table in doc.items():
+        if isinstance(table, dict) and isinstance(base.get(section), dict):
+            base[section] = {**base[section], **table}
+        else:
+            base[section] = table
+    return base
 
-    known = {(s, n) for s, n, _, _ in SCHEMA} | {("clutch", "calibration")}
+
+def load_plant(path) -> PlantParams:
+    """Read and validate a plant file (every parameter { value, unit, source }, the OPTIONAL ones defaulted;
+    [clutch].calibration and [offgoing].calibration paths relative to the plant file; extends = a base plant
+    file). Raises PlantError naming the file and the parameter."""
+    path = Path(path)
+    where = str(path)
+    doc = _read_doc(path, (path.resolve(),))
+
+    known = {(s, n) for s, n, _, _ in SCHEMA} | set(_PATH_KEYS)
     sections = {s for s, _ in known}
     for section, table in doc.items():
         if section not in sections:
@@ -141,23 +239,35 @@ def load_plant(path) -> PlantParams:
             if (section, name) not in known:
                 raise PlantError(f"{where}: unknown parameter '{section}.{name}'")
 
+    def load_cal(section):
+        entry = doc.get(section, {}).get("calibration")
+        if not isinstance(entry, str) or not entry.strip():
+            raise PlantError(f"{where}: parameter '{section}.calibration' must be a path string (relative to the "
+                             f"plant file)")
+        cal_path = (path.parent / entry).resolve()
+        try:
+            return calibration.load(cal_path), str(cal_path)
+        except calibration.CalibrationError as e:
+            raise PlantError(f"{where}: parameter '{section}.calibration': {e}") from None
+
     values: dict = {}
     sources: dict = {}
-    cal_entry = doc.get("clutch", {}).get("calibration")
-    if cal_entry is None:
+    if doc.get("clutch", {}).get("calibration") is None:
         raise PlantError(f"{where}: missing parameter 'clutch.calibration' (path of the true clutch calibration)")
-    if not isinstance(cal_entry, str) or not cal_entry.strip():
-        raise PlantError(f"{where}: parameter 'clutch.calibration' must be a path string (relative to the plant file)")
-    cal_path = (path.parent / cal_entry).resolve()
-    try:
-        cal = calibration.load(cal_path)
-    except calibration.CalibrationError as e:
-        raise PlantError(f"{where}: parameter 'clutch.calibration': {e}") from None
+    cal, cal_path = load_cal("clutch")
+    if doc.get("offgoing", {}).get("calibration") is None:
+        off_cal, off_path = cal, cal_path
+    else:
+        off_cal, off_path = load_cal("offgoing")
 
+    deferred = []
     for section, name, unit, constraint in SCHEMA:
         q = f"{section}.{name}"
         entry = doc.get(section, {}).get(name)
         if entry is None:
+            if name in OPTIONAL:
+                deferred.append(name)
+                continue
             raise PlantError(f"{where}: missing parameter '{q}' (unit {unit})")
         if not isinstance(entry, dict) or "value" not in entry:
             raise PlantError(f"{where}: parameter '{q}' must be {{ value = ..., unit = \"{unit}\", source = \"...\" }}")
@@ -189,9 +299,20 @@ def load_plant(path) -> PlantParams:
                 raise PlantError(f"{where}: parameter '{q}': value {raw!r} must be in [{lo:g}, {hi:g}] {unit}")
         values[name] = v
         sources[name] = src
+    for name in deferred:
+        default, src = DEFAULTS[name]
+        values[name] = float(default(values) if callable(default) else default)
+        sources[name] = src
 
     if not values["ratio_1st"] > values["ratio_2nd"]:
         raise PlantError(f"{where}: parameter 'driveline.ratio_2nd' must be < driveline.ratio_1st (an upshift)")
     if not values["turbine_speed"] * RPM / values["ratio_1st"] > 0:
         raise PlantError(f"{where}: parameter 'scenario.turbine_speed' must be > 0 rpm")
-    return PlantParams(clutch_cal=cal, calibration_path=str(cal_path), sources=sources, path=where, **values)
+    if not values["engine_torque_min"] < values["engine_torque_max"]:
+        raise PlantError(f"{where}: parameter 'engine.engine_torque_min' must be < engine.engine_torque_max")
+    periods = values["engine_delay"] / DT_S
+    if abs(periods - round(periods)) > 1e-6:
+        raise PlantError(f"{where}: parameter 'engine.engine_delay': {values['engine_delay']!r} s is not a whole "
+                         f"number of {DT_S:g} s periods")
+    return PlantParams(clutch_cal=cal, calibration_path=cal_path, offgoing_cal=off_cal,
+                       offgoing_calibration_path=off_path, sources=sources, path=where, **values)
