@@ -1,0 +1,143 @@
+"""The TCU's driveline model of a vehicle, generated from its plant file (issue 22, item 5; DESIGN 10, 14):
+``tools/calibrations/vehicles/<vehicle>.toml`` from ``tools/plants/vehicles/<vehicle>.toml``.
+
+The shift controller's model of DESIGN 10 (rigid driveline, the vehicle referred to the output shaft) from
+the plant's parameters, in the fields of wc_shift_calibration_t (include/wetclutch/wc_shift.h):
+
+  turbine_inertia_kg_m2   I_t                                 plant driveline.turbine_inertia
+  turbine_ratio           a = 1                               (the on-coming clutch turns with the turbine)
+  output_inertia_kg_m2    I_o + m r_w^2 / r_f^2               output shaft + the vehicle at the output shaft
+  output_ratio            b = i2                              on-coming slip = w_t - i2 w_o
+  offgoing_ratio          b1 = i1                             off-going slip = w_t - i1 w_o
+  jerk_per_torque_rate    i2 r_f / (m r_w)                    vehicle jerk per on-coming torque rate
+
+The file written holds these as the [shift] entries of a shift calibration (tools/calibrations/
+shift_1_2.toml's format: { value, unit, source }, the short names), values rounded to 6 significant digits
+(the firmware's floats hold about 7), behind a "generated ... do not edit" banner. generate_all writes one
+per plant file of a directory; the tests regenerate them and compare byte for byte.
+
+API: driveline_fields(params) -> {C field: value}; entries(params) -> [(name, value, unit, source)];
+text(params, plant_name) -> str; write(params, out_path) -> Path; generate_all(plants_dir, out_dir) ->
+[Path]; main(argv) (``wetclutch vehicle-cal [PLANTS_DIR] [--out DIR]``).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from ..simulate.plant import DEFAULT_PLANT, PlantError, PlantParams, load_plant
+from ..util.atomic import Staged
+
+REPO_ROOT = DEFAULT_PLANT.parents[2]
+PLANTS_DIR = REPO_ROOT / "tools" / "plants" / "vehicles"
+OUT_DIR = REPO_ROOT / "tools" / "calibrations" / "vehicles"
+COMMAND = "wetclutch vehicle-cal"
+
+# (name in the shift calibration file, C field of wc_shift_calibration_t, unit), in the struct's order
+NAMES: tuple[tuple[str, str, str], ...] = (
+    ("turbine_inertia", "turbine_inertia_kg_m2", "kg*m^2"),
+    ("turbine_ratio", "turbine_ratio", "1"),
+    ("output_inertia", "output_inertia_kg_m2", "kg*m^2"),
+    ("output_ratio", "output_ratio", "1"),
+    ("offgoing_ratio", "offgoing_ratio", "1"),
+    ("jerk_per_torque_rate", "jerk_per_torque_rate", "(m/s^3)/(Nm/s)"),
+)
+
+
+def _round(v: float) -> float:
+    return float(f"{v:.6g}")
+
+
+def driveline_fields(params: PlantParams) -> dict:
+    """The TCU's driveline model of the plant, {C field name of wc_shift_calibration_t: value} (rounded to
+    6 significant digits, as written)."""
+    return {c: v for (_, c, _), (_, v, _, _) in zip(NAMES, entries(params))}
+
+
+def entries(params: PlantParams) -> list:
+    """[(name, value, unit, source)] in the struct's order (module docstring)."""
+    p = params
+    m, rw, rf, i1, i2 = p.vehicle_mass, p.wheel_radius, p.final_drive, p.ratio_1st, p.ratio_2nd
+    vehicle_at_output = m * rw ** 2 / rf ** 2
+    values = {
+        "turbine_inertia": (p.turbine_inertia,
+                            "I_t: plant driveline.turbine_inertia (engine + locked converter + input members)"),
+        "turbine_ratio": (1.0, "a = 1: the on-coming clutch of the 1->2 shift turns with the turbine "
+                               "(slip = w_t - i2 w_o)"),
+        "output_inertia": (p.output_inertia + vehicle_at_output,
+                           f"I_o + m r_w^2 / r_f^2 = {p.output_inertia:g} + {m:g} * {rw:g}^2 / {rf:g}^2 "
+                           f"= {p.output_inertia:g} + {vehicle_at_output:.4g} (rigid driveline)"),
+        "output_ratio": (i2, f"b = i2 = plant driveline.ratio_2nd {i2:g} (on-coming slip = w_t - i2 w_o)"),
+        "offgoing_ratio": (i1, f"b1 = i1 = plant driveline.ratio_1st {i1:g} (off-going slip = w_t - i1 w_o)"),
+        "jerk_per_torque_rate": (i2 * rf / (m * rw),
+                                 f"b r_f / (m r_w) = {i2:g} * {rf:g} / ({m:g} kg * {rw:g} m) (rigid driveline)"),
+    }
+    return [(name, _round(values[name][0]), unit, values[name][1]) for name, _, unit in NAMES]
+
+
+def _toml_str(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _plant_name(params: PlantParams) -> str:
+    path = Path(params.path).resolve()
+    try:
+        return Path(os.path.relpath(path, REPO_ROOT)).as_posix() if path.is_relative_to(REPO_ROOT) else path.name
+    except ValueError:
+        return path.name
+
+
+def text(params: PlantParams, plant_name: str | None = None) -> str:
+    """The generated file's text (deterministic: the plant's values and its name only)."""
+    name = _plant_name(params) if plant_name is None else plant_name
+    rows = entries(params)
+    width = max(len(n) for n, _, _, _ in rows)
+    lines = [f"# generated by {COMMAND} from {name}, do not edit",
+             "# The TCU's driveline model of this vehicle (DESIGN 10, 14; wetclutch.generate.vehicle_cal): the",
+             "# [shift] entries of a shift calibration (format of tools/calibrations/shift_1_2.toml), from the",
+             "# plant's parameters, rigid driveline, the vehicle referred to the output shaft.",
+             "",
+             "[shift]"]
+    for n, v, unit, src in rows:
+        lines.append(f"{n.ljust(width)} = {{ value = {v!r}, unit = {_toml_str(unit)}, source = {_toml_str(src)} }}")
+    return "\n".join(lines) + "\n"
+
+
+def write(params: PlantParams, out_path, plant_name: str | None = None) -> Path:
+    """Write the vehicle's driveline calibration to out_path (atomically); the path written."""
+    out = Path(out_path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with Staged() as staged:
+        staged.write_text(out, text(params, plant_name))
+    return out
+
+
+def generate_all(plants_dir=PLANTS_DIR, out_dir=OUT_DIR) -> list:
+    """One <vehicle>.toml in out_dir per plant file <vehicle>.toml of plants_dir (sorted); the paths written.
+    A bad plant file raises PlantError naming it."""
+    plants = sorted(Path(plants_dir).glob("*.toml"))
+    if not plants:
+        raise PlantError(f"{plants_dir}: no plant files (*.toml)")
+    loaded = [(f, load_plant(f)) for f in plants]          # all checked before anything is written
+    return [write(params, Path(out_dir) / f.name) for f, params in loaded]
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog=COMMAND, description="Generate the TCU's driveline calibration of each "
+                                 "vehicle plant file (tools/calibrations/vehicles/<vehicle>.toml).")
+    ap.add_argument("plants_dir", nargs="?", default=str(PLANTS_DIR), help="directory of vehicle plant files")
+    ap.add_argument("--out", default=str(OUT_DIR), help="output directory")
+    args = ap.parse_args(argv)
+    try:
+        for path in generate_all(args.plants_dir, args.out):
+            print(path)
+    except PlantError as e:
+        print(f"{COMMAND}: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":      # pragma: no cover
+    raise SystemExit(main())
