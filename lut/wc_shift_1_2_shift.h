@@ -50,6 +50,23 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
     .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
     .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
     .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 0u, /* 1; 0: the on-coming clutch alone; 1: fill, off-going clutch, engine intervention, per-phase fallback */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 0u, /* 1; 0: no engine request */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
 /* blind: (b) 2-DOF with a thermal-blind model: clutch temperature = oil temperature */
@@ -97,6 +114,23 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
     .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
     .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 0u, /* 1; 0: the on-coming clutch alone; 1: fill, off-going clutch, engine intervention, per-phase fallback */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 0u, /* 1; 0: no engine request */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
 /* feedback: (a) feedback only: PI on the slip, no feed-forward, no lag compensation */
@@ -144,6 +178,23 @@ static const wc_shift_calibration_t wc_shift_1_2_feedback = {
     .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
     .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
     .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 0u, /* 1; 0: the on-coming clutch alone; 1: fill, off-going clutch, engine intervention, per-phase fallback */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 0u, /* 1; 0: no engine request */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
 /* adaptive: (c) with adaptation (DESIGN 12): learns the friction scale per temperature, the film factor and the kiss point */
@@ -191,6 +242,215 @@ static const wc_shift_calibration_t wc_shift_1_2_adaptive = {
     .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
     .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
     .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 0u, /* 1; 0: the on-coming clutch alone; 1: fill, off-going clutch, engine intervention, per-phase fallback */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 0u, /* 1; 0: no engine request */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
+};
+
+/* whole_full: (c) on the whole shift (DESIGN 14): fill, off-going clutch, engine intervention, 2-DOF full model */
+static const wc_shift_calibration_t wc_shift_1_2_whole_full = {
+    .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
+    .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
+    .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
+    .prepare_time_s = 0.06f, /* s; fill pulse 30 ms, then 30 ms at the kiss point (the piston's last stroke) */
+    .torque_phase_time_s = 0.25f, /* s; the hand-over under the off-going clutch's control (no scripted release to match): 0.25 s keeps the torque phase's jerk below 10 m/s^3 without the engine */
+    .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
+    .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
+    .inertia_timeout_factor = 1.6f, /* 1; abort (release) when the inertia phase lasts 1.6 x its target */
+    .lockup_ramp_time_s = 0.05f, /* s; hand-over from the last request to the holding request */
+    .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
+    .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
+    .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
+    .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
+    .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
+    .lag_compensation_time_s = 0.015f, /* s; modelled pressure led to approach its target with 15 ms instead of tau = 60 ms (DESIGN 9) */
+    .theta_source = 0u, /* 1; 0: the observer's friction-surface temperature */
+    .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
+    .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
+    .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update); 0.8 recovered slower from a faulted shift (0.020 of a 0.05 step left after 5 good shifts, 0.016 at 0.6) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.0f, /* 1; 0: the film factor is not learned. The early/late torque ratio of the inertia phase carries no film signal on these plants: on the matched plant it drifted the factor 6.5 % down in 8 shifts (0.5 gain) and cost the +20 % friction plant 2-5 rpm of slip RMSE; the mechanism stays for a clutch where it is observable */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.0f, /* 1; 0: the kiss point is not learned. In the inertia phase the contact force varies too little to tell an offset from a scale: the least squares put friction errors on the kiss point (plant friction -10 %, 20 degC oil: -10 kPa per shift at the step limit, -40 kPa after 4 shifts; -20 %, 40 degC: a first estimate of -161 kPa). It needs the fill phase with a turbine speed (issue 22); the mechanism and its bounds stay */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 1u, /* 1; the whole shift */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 1u, /* 1; engine torque intervention on */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
+};
+
+/* whole_blind: (b) on the whole shift: as whole_full with the thermal-blind model */
+static const wc_shift_calibration_t wc_shift_1_2_whole_blind = {
+    .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
+    .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
+    .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
+    .prepare_time_s = 0.06f, /* s; as whole_full */
+    .torque_phase_time_s = 0.25f, /* s; as whole_full */
+    .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
+    .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
+    .inertia_timeout_factor = 1.6f, /* 1; abort (release) when the inertia phase lasts 1.6 x its target */
+    .lockup_ramp_time_s = 0.05f, /* s; hand-over from the last request to the holding request */
+    .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
+    .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
+    .feedforward_gain = 1.0f, /* 1; 2-DOF: the driveline feed-forward (DESIGN 10) */
+    .kp_Nm_per_rad_s = 10.0f, /* Nm/(rad/s); slip PI, proportional: grid 3/6/10/16 x ki 40/120/300 on the nominal scenario, best slip RMSE with the inertia time within 5 % (wetclutch shift --tune-feedback) */
+    .ki_Nm_per_rad = 40.0f, /* Nm/rad; slip PI, integral: same grid (ki 120/300 settle the last slip slower: +4..+6 % inertia time) */
+    .integral_limit_Nm = 150.0f, /* Nm; anti-windup bound: the PI corrects a model error, the feed-forward carries the load */
+    .lag_compensation_time_s = 0.015f, /* s; modelled pressure led to approach its target with 15 ms instead of tau = 60 ms (DESIGN 9) */
+    .theta_source = 1u, /* 1; 1: the oil temperature (no observer) */
+    .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
+    .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
+    .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update); 0.8 recovered slower from a faulted shift (0.020 of a 0.05 step left after 5 good shifts, 0.016 at 0.6) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.0f, /* 1; 0: the film factor is not learned. The early/late torque ratio of the inertia phase carries no film signal on these plants: on the matched plant it drifted the factor 6.5 % down in 8 shifts (0.5 gain) and cost the +20 % friction plant 2-5 rpm of slip RMSE; the mechanism stays for a clutch where it is observable */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.0f, /* 1; 0: the kiss point is not learned. In the inertia phase the contact force varies too little to tell an offset from a scale: the least squares put friction errors on the kiss point (plant friction -10 %, 20 degC oil: -10 kPa per shift at the step limit, -40 kPa after 4 shifts; -20 %, 40 degC: a first estimate of -161 kPa). It needs the fill phase with a turbine speed (issue 22); the mechanism and its bounds stay */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 1u, /* 1; the whole shift */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 1u, /* 1; engine torque intervention on */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
+};
+
+/* whole_feedback: (a) on the whole shift: as whole_full with the inertia phase on feedback only */
+static const wc_shift_calibration_t wc_shift_1_2_whole_feedback = {
+    .turbine_inertia_kg_m2 = 0.25f, /* kg*m^2; engine + locked converter + input members, as the plant's nominal value (tools/plants/upshift_1_2.toml) */
+    .turbine_ratio = 1.0f, /* 1; on-coming clutch of the 1->2 shift turns with the turbine: slip = w_t - i2 w_o (a = 1) */
+    .output_inertia_kg_m2 = 15.1f, /* kg*m^2; output shaft 0.10 + vehicle m r_w^2 / r_f^2 = 1600 * 0.31^2 / 3.2^2 = 15.0 (the plant's nominal values) */
+    .output_ratio = 3.1f, /* 1; b = i2: 2nd gear (slip = w_t - i2 w_o) */
+    .jerk_per_torque_rate = 0.02f, /* (m/s^3)/(Nm/s); b r_f / (m r_w) = 3.1 * 3.2 / (1600 kg * 0.31 m) (rigid driveline) */
+    .prepare_time_s = 0.06f, /* s; as whole_full */
+    .torque_phase_time_s = 0.25f, /* s; as whole_full */
+    .inertia_time_min_s = 0.2f, /* s; shortest accepted target: faster would exceed the comfort jerk */
+    .inertia_time_max_s = 2.0f, /* s; longest accepted target (DBC TargetInertiaTime range) */
+    .inertia_timeout_factor = 1.6f, /* 1; abort (release) when the inertia phase lasts 1.6 x its target */
+    .lockup_ramp_time_s = 0.05f, /* s; hand-over from the last request to the holding request */
+    .holding_torque_factor = 1.3f, /* 1; holding request 1.3 x T_t / a (the lock-up adds its holding margin) */
+    .min_start_slip_rad_s = 5.0f, /* rad/s; no inertia phase below 48 rpm of slip */
+    .feedforward_gain = 0.0f, /* 1; no feed-forward */
+    .kp_Nm_per_rad_s = 32.0f, /* Nm/(rad/s); as feedback (issue 13's search) */
+    .ki_Nm_per_rad = 160.0f, /* Nm/rad; as feedback */
+    .integral_limit_Nm = 1000.0f, /* Nm; the integral carries the whole load */
+    .lag_compensation_time_s = 0.0f, /* s; no lag compensation */
+    .theta_source = 1u, /* 1; oil temperature in the torque -> current map */
+    .flare_slip_rad_s = 10.0f, /* rad/s; flare: slip 95 rpm above its inertia-phase start */
+    .tie_up_factor = 1.5f, /* 1; tie-up: request above 1.5 x T_t / a while the slip does not fall */
+    .jerk_filter_time_s = 0.02f, /* s; jerk estimate: torque filtered with 20 ms (ride-comfort band below about 8 Hz) */
+    .adaptation = 0u, /* 1; 0: off, the controller bit for bit the unadapted one */
+    .adapt_theta_node_degC[0] = 40.0f, /* degC; friction scale nodes over the friction-surface temperatures of shifts at 20..110 degC oil */
+    .adapt_theta_node_degC[1] = 80.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[2] = 120.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[3] = 160.0f, /* degC; as node 0 */
+    .adapt_theta_node_degC[4] = 200.0f, /* degC; as node 0 */
+    .adapt_scale_band = 0.3f, /* 1; friction scale within 0.7..1.3: a lining outside it is a fault, not an adaptation */
+    .adapt_scale_step = 0.05f, /* 1; at most 5 % per shift: one bad shift moves the scale by no more */
+    .adapt_scale_gain = 0.6f, /* 1; 60 % of a shift's measured error taken (filtered update); 0.8 recovered slower from a faulted shift (0.020 of a 0.05 step left after 5 good shifts, 0.016 at 0.6) */
+    .adapt_confidence_gain = 0.3f, /* 1; confidence 0.3 after one full-share update, 0.83 after five */
+    .adapt_film_factor_min = 0.2f, /* 1; film factor band 0.2..5 x the calibration's */
+    .adapt_film_factor_max = 5.0f, /* 1; as the minimum */
+    .adapt_film_step = 0.3f, /* 1; at most 30 % per shift */
+    .adapt_film_gain = 0.0f, /* 1; 0: the film factor is not learned. The early/late torque ratio of the inertia phase carries no film signal on these plants: on the matched plant it drifted the factor 6.5 % down in 8 shifts (0.5 gain) and cost the +20 % friction plant 2-5 rpm of slip RMSE; the mechanism stays for a clutch where it is observable */
+    .adapt_kiss_band_Pa = 60000.0f, /* Pa; kiss point within +-60 kPa of the calibration's 119 kPa (F_s / A_p) */
+    .adapt_kiss_step_Pa = 10000.0f, /* Pa; at most 10 kPa per shift */
+    .adapt_kiss_gain = 0.0f, /* 1; 0: the kiss point is not learned. In the inertia phase the contact force varies too little to tell an offset from a scale: the least squares put friction errors on the kiss point (plant friction -10 %, 20 degC oil: -10 kPa per shift at the step limit, -40 kPa after 4 shifts; -20 %, 40 degC: a first estimate of -161 kPa). It needs the fill phase with a turbine speed (issue 22); the mechanism and its bounds stay */
+    .adapt_window_skip_s = 0.03f, /* s; the window starts 30 ms into the inertia phase (the off-going clutch's last torque) */
+    .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
+    .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
+    .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 1u, /* 1; the whole shift */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 1u, /* 1; engine torque intervention on */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
 /* nolag: (c) without the lag compensation (pressure-tracking comparison) */
@@ -238,6 +498,23 @@ static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .adapt_film_window_s = 0.1f, /* s; the film factor's early part of the window */
     .adapt_min_slip_drop = 0.5f, /* 1; excitation: the slip falls by half its value in the window */
     .adapt_min_conditioning = 0.05f, /* 1; the kiss point's least squares: force varied enough to tell an offset from a scale */
+    .coordinator = 0u, /* 1; 0: the on-coming clutch alone; 1: fill, off-going clutch, engine intervention, per-phase fallback */
+    .offgoing_ratio = 4.7f, /* 1; b1 = i1: 1st gear (the nominal plant's ratio_1st) */
+    .fill_pulse_current_mA = 500.0f, /* mA; fill pulse: 1150 kPa against the 119 kPa kiss pressure strokes the piston in about 35 ms on the nominal plant's fill volume (tools/plants/vehicles/nominal.toml) */
+    .fill_pulse_time_s = 0.03f, /* s; a little short of the pulse's fill time, so the piston reaches the plates at the kiss pressure, not at the pulse's */
+    .offgoing_holding_factor = 1.5f, /* 1; off-going capacity before the torque phase 1.5 x T_t (usual holding margin 1.3..2, the plant's scripted holding) */
+    .offgoing_margin_factor = 0.05f, /* 1; torque phase: the off-going request is what it still carries + 5 % of T_t0 (its lock-up adds its holding margin 0.2 on top): a 20 % weaker off-going lining does not slip, a 20 % stronger one ties up by at most about 6 % of T_t0 */
+    .offgoing_lag_compensation_time_s = 0.015f, /* s; the off-going pressure led like the on-coming one (DESIGN 9): its capacity follows the falling request with 15 ms, not 60 ms */
+    .flare_kp_Nm_per_rad_s = 5.0f, /* Nm/(rad/s); flare correction: +5 Nm of off-going capacity per rad/s (9.5 rpm) of flare */
+    .flare_ki_Nm_per_rad = 200.0f, /* Nm/rad; flare correction's integral: a 10 rad/s flare adds 2 Nm per ms */
+    .handover_slip_rad_s = 2.0f, /* rad/s; off-going slip below -19 rpm: the on-coming clutch holds the turbine (beyond the speed sensors' noise, 0.5 rpm); release at once (tie-up) */
+    .engine_intervention = 0u, /* 1; 0: no engine request */
+    .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
+    .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
+    .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
+    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
 #endif /* WC_LUT_SHIFT_1_2_SHIFT_H */

@@ -319,7 +319,7 @@ THUNK(thunk_shift_step)
 {
     bench_ctx_t *c = ctx;
     c->shift_ended = wc_shift_step(c->shift, c->shift_cal, &c->shift_command, false, c->clutch, c->adapt, &c->step_in,
-                                   &c->step_out, &c->shift_report);
+                                   &c->step_out, &c->shift_report, NULL);
 }
 THUNK(thunk_decode_clutch_sensors)
 {

@@ -116,6 +116,27 @@ typedef struct wc_shift_calibration {
     float adapt_film_window_s;         /* the film factor's early part of the window */
     float adapt_min_slip_drop;         /* excitation: the slip falls by this fraction of its window start */
     float adapt_min_conditioning;      /* the kiss point's least squares: D / (S11 S22) at least this */
+    /* The whole shift (DESIGN 14): 0 = the on-coming clutch alone, bit for bit
+     * the controller above (the off-going clutch and the engine are not ours);
+     * 1 = the coordinator: fill, the off-going clutch's capacity, the engine
+     * torque intervention and the per-phase fallback of a lost input. */
+    uint32_t coordinator;
+    float offgoing_ratio;              /* b1 = i1: the off-going clutch's slip a w_t - b1 w_o (1st gear); > output_ratio */
+    float fill_pulse_current_mA;       /* fill: this VFS current for fill_pulse_time_s, then the kiss point */
+    float fill_pulse_time_s;           /* <= prepare_time_s */
+    float offgoing_holding_factor;     /* off-going capacity request before the torque phase / T_t */
+    float offgoing_margin_factor;      /* torque phase: request = carried torque + factor * T_t0 (+ its lock-up margin) */
+    float offgoing_lag_compensation_time_s;  /* the off-going clutch's lag compensation (DESIGN 9); 0: off */
+    float flare_kp_Nm_per_rad_s;       /* torque phase: off-going request + kp * (off-going slip > 0) ... */
+    float flare_ki_Nm_per_rad;         /* ... + ki * its integral (flare corrected in closed loop) */
+    float handover_slip_rad_s;         /* off-going slip below -this: the on-coming holds the turbine (tie-up): release */
+    uint32_t engine_intervention;      /* 1: request engine torque (DBC EngineTorqueRequest) */
+    float engine_increase_max_Nm;      /* torque phase: increase <= this */
+    float engine_reduction_max_Nm;     /* inertia phase: reduction <= this */
+    float engine_fill_fraction;        /* torque phase: increase = fraction * (b1 - b) / b * T_t0 (the torque hole) */
+    float engine_reduction_fraction;   /* inertia phase: reduction = fraction * T_t0, reached with the reference */
+    float engine_recovery_time_s;      /* after the inertia phase the reduction ramps out in this time */
+    float fallback_time_s;             /* a lost input in the inertia phase or later: finish on the model this long at most */
 } wc_shift_calibration_t;
 
 /* Which field an invalid shift calibration fails on (0 = valid): the fields
@@ -166,6 +187,23 @@ typedef enum {
     WC_SHIFT_CAL_ADAPT_FILM_WINDOW,
     WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP,
     WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING,
+    WC_SHIFT_CAL_COORDINATOR,
+    WC_SHIFT_CAL_OFFGOING_RATIO,       /* also: coordinator 1 and not above output_ratio */
+    WC_SHIFT_CAL_FILL_PULSE_CURRENT,
+    WC_SHIFT_CAL_FILL_PULSE_TIME,      /* also: above prepare_time_s */
+    WC_SHIFT_CAL_OFFGOING_HOLDING_FACTOR,
+    WC_SHIFT_CAL_OFFGOING_MARGIN_FACTOR,
+    WC_SHIFT_CAL_OFFGOING_LAG_COMPENSATION_TIME,
+    WC_SHIFT_CAL_FLARE_KP,
+    WC_SHIFT_CAL_FLARE_KI,
+    WC_SHIFT_CAL_HANDOVER_SLIP,
+    WC_SHIFT_CAL_ENGINE_INTERVENTION,
+    WC_SHIFT_CAL_ENGINE_INCREASE_MAX,
+    WC_SHIFT_CAL_ENGINE_REDUCTION_MAX,
+    WC_SHIFT_CAL_ENGINE_FILL_FRACTION,
+    WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION,
+    WC_SHIFT_CAL_ENGINE_RECOVERY_TIME,
+    WC_SHIFT_CAL_FALLBACK_TIME,
     WC_SHIFT_CAL_ERRORS
 } wc_shift_cal_error_t;
 
@@ -178,12 +216,40 @@ typedef enum {
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MIN_s 0.05f
 #define WC_SHIFT_LIMIT_INERTIA_TIME_MAX_s 5.0f
 #define WC_SHIFT_LIMIT_GAIN_MAX 1e5f
+/* The fill pulse's current: within the DBC's VfsCurrent range. */
+#define WC_SHIFT_LIMIT_CURRENT_MAX_mA 2000.0f
+/* The engine request's limits: within the DBC's EngineTorqueRequest.TorqueDelta range. */
+#define WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm 1000.0f
 /* The kiss offset's band: at most 1 MPa (a kiss pressure is about 0.1 MPa). */
 #define WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa 1e6f
 /* The hand-over waits this many lockup_ramp_time_s for the lock-up (its dwell, a slow cold film). */
 #define WC_SHIFT_LOCKUP_WAIT 4u
 
 wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal);
+
+/* The fallback of a shift whose input was lost (DESIGN 14; the values of DBC
+ * OffgoingVfsCommand.Fallback). Only with the coordinator; without it a lost
+ * input releases the clutch (AbortReason 3). */
+typedef enum {
+    WC_SHIFT_FALLBACK_NONE = 0,
+    WC_SHIFT_FALLBACK_FINISH = 1,    /* inertia phase or later: finished on the model (feed-forward on the
+                                      * reference, no feedback), for at most fallback_time_s */
+    WC_SHIFT_FALLBACK_HANDBACK = 2,  /* prepare or torque phase: handed back to the off-going gear (off-going at
+                                      * its maximum current, on-coming released); AbortReason 3 */
+    WC_SHIFT_FALLBACK_RELEASED = 3   /* neither possible (the finish took longer than fallback_time_s): released */
+} wc_shift_fallback_t;
+
+/* The second clutch and the engine of the whole shift (coordinator 1). The
+ * off-going clutch is the caller's wc_clutch_t with its own calibration; in
+ * holds its sensors (slip: the off-going slip a w_t - b1 w_o, temperatures),
+ * the controller writes the rest and steps it. */
+typedef struct {
+    wc_clutch_t *clutch;
+    wc_step_input_t *in;
+    wc_step_output_t *out;
+    bool engine_active;            /* out: DBC EngineTorqueRequest.InterventionActive */
+    float engine_delta_Nm;         /* out: its TorqueDelta (0 when not active) */
+} wc_shift_offgoing_t;
 
 /* The shift command (DBC ShiftCommand), as the frame loop received it. */
 typedef struct {
@@ -204,6 +270,7 @@ typedef struct {
     bool tie_up;
     uint32_t abort_reason;         /* wc_shift_abort_t */
     wc_adapt_change_t adaptation;  /* what the shift changed of the learned values (DESIGN 12) */
+    uint32_t fallback;             /* wc_shift_fallback_t (coordinator) */
 } wc_shift_report_t;
 
 typedef struct {
@@ -222,6 +289,19 @@ typedef struct {
     uint32_t band_periods;         /* consecutive periods with the slip inside the lock band */
     wc_lag_compensation_t lag_compensation;  /* of the calibration's time, made at the shift's start */
     wc_shift_report_t report;      /* running, final at the end */
+    /* The whole shift (coordinator, DESIGN 14) */
+    float driver_torque_Nm;        /* T_t0: the turbine torque at the command, before any intervention */
+    float oncoming_torque_Nm;      /* the on-coming model's torque of the last step */
+    float flare_integral_Nm;       /* off-going flare correction's integral */
+    float engine_delta_Nm;         /* the engine request of the last step */
+    float engine_from_Nm;          /* the request when the reduction's recovery began */
+    uint32_t fallback;             /* wc_shift_fallback_t of the running shift */
+    uint32_t fallback_periods;     /* periods since the input was lost */
+    uint32_t recovery_periods;     /* periods since the engine's recovery began */
+    float offgoing_slip_rad_s;     /* this step's off-going slip (measured, else the clutch's last valid) */
+    bool second_gear;              /* the on-coming clutch has the gear (from the inertia phase until the
+                                    * command's withdrawal): the off-going clutch stays open */
+    wc_lag_compensation_t offgoing_lag;  /* the off-going clutch's lag compensation */
 } wc_shift_t;
 
 void wc_shift_init(wc_shift_t *shift);
@@ -257,9 +337,14 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
  * bit already 1 when the safe state ends starts no shift: a new 0 -> 1 edge
  * is needed (no restart without the VCU's consent). adapt: the clutch's
  * learned values (DESIGN 12), used and updated when cal->adaptation is 1;
- * NULL (or adaptation 0): none, and the report's adaptation part says OFF. */
+ * NULL (or adaptation 0): none, and the report's adaptation part says OFF.
+ * offgoing: the off-going clutch and the engine request (coordinator 1,
+ * DESIGN 14; NULL otherwise; with the coordinator and NULL the shift runs
+ * without the off-going clutch and the engine, as coordinator 0). The
+ * coordinator also runs in IDLE (the off-going clutch holds 1st gear at
+ * offgoing_holding_factor * T_t; at its maximum current in the safe state). */
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                    bool safe, wc_clutch_t *clutch, wc_adapt_t *adapt, wc_step_input_t *in, wc_step_output_t *out,
-                   wc_shift_report_t *report);
+                   wc_shift_report_t *report, wc_shift_offgoing_t *offgoing);
 
 #endif /* WC_SHIFT_H */

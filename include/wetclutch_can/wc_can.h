@@ -49,10 +49,13 @@ extern "C" {
 #define WC_CAN_CLUTCH_SENSORS_FRAME_ID (0x110u)
 #define WC_CAN_TORQUE_REQUEST_FRAME_ID (0x111u)
 #define WC_CAN_SHIFT_COMMAND_FRAME_ID (0x112u)
+#define WC_CAN_OFFGOING_SENSORS_FRAME_ID (0x113u)
 #define WC_CAN_VFS_COMMAND_FRAME_ID (0x120u)
 #define WC_CAN_CLUTCH_ESTIMATE_FRAME_ID (0x121u)
 #define WC_CAN_SHIFT_REPORT_FRAME_ID (0x122u)
 #define WC_CAN_ADAPTATION_REPORT_FRAME_ID (0x123u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID (0x124u)
+#define WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID (0x125u)
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
 #define WC_CAN_XCP_COMMAND_FRAME_ID (0x7f0u)
 #define WC_CAN_XCP_RESPONSE_FRAME_ID (0x7f1u)
@@ -61,10 +64,13 @@ extern "C" {
 #define WC_CAN_CLUTCH_SENSORS_LENGTH (8u)
 #define WC_CAN_TORQUE_REQUEST_LENGTH (8u)
 #define WC_CAN_SHIFT_COMMAND_LENGTH (8u)
+#define WC_CAN_OFFGOING_SENSORS_LENGTH (8u)
 #define WC_CAN_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_CLUTCH_ESTIMATE_LENGTH (8u)
 #define WC_CAN_SHIFT_REPORT_LENGTH (8u)
 #define WC_CAN_ADAPTATION_REPORT_LENGTH (8u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH (8u)
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
 #define WC_CAN_XCP_COMMAND_LENGTH (8u)
 #define WC_CAN_XCP_RESPONSE_LENGTH (8u)
@@ -73,10 +79,13 @@ extern "C" {
 #define WC_CAN_CLUTCH_SENSORS_IS_EXTENDED (0)
 #define WC_CAN_TORQUE_REQUEST_IS_EXTENDED (0)
 #define WC_CAN_SHIFT_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_OFFGOING_SENSORS_IS_EXTENDED (0)
 #define WC_CAN_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_CLUTCH_ESTIMATE_IS_EXTENDED (0)
 #define WC_CAN_SHIFT_REPORT_IS_EXTENDED (0)
 #define WC_CAN_ADAPTATION_REPORT_IS_EXTENDED (0)
+#define WC_CAN_OFFGOING_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ENGINE_TORQUE_REQUEST_IS_EXTENDED (0)
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
 #define WC_CAN_XCP_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_XCP_RESPONSE_IS_EXTENDED (0)
@@ -85,8 +94,11 @@ extern "C" {
 #define WC_CAN_CLUTCH_SENSORS_CYCLE_TIME_MS (1u)
 #define WC_CAN_TORQUE_REQUEST_CYCLE_TIME_MS (1u)
 #define WC_CAN_SHIFT_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_OFFGOING_SENSORS_CYCLE_TIME_MS (1u)
 #define WC_CAN_VFS_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_CLUTCH_ESTIMATE_CYCLE_TIME_MS (1u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ENGINE_TORQUE_REQUEST_CYCLE_TIME_MS (1u)
 #define WC_CAN_BENCH_MEASUREMENT_CYCLE_TIME_MS (1u)
 
 /* Signal choices. */
@@ -109,6 +121,8 @@ extern "C" {
 
 #define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE (4095u)
 
+#define WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE (-32768)
+
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_SNA_CHOICE (4095u)
 
 #define WC_CAN_CLUTCH_ESTIMATE_LOCK_STATE_SLIPPING_CHOICE (0u)
@@ -130,6 +144,11 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_ABORT_REASON_INVALID_COMMAND_CHOICE (5u)
 #define WC_CAN_SHIFT_REPORT_ABORT_REASON_NO_SLIP_CHOICE (6u)
 
+#define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_NONE_CHOICE (0u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_FINISH_ON_MODEL_CHOICE (1u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_HAND_BACK_CHOICE (2u)
+#define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_RELEASED_CHOICE (3u)
+
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_SNA_CHOICE (-524288)
 
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_SNA_CHOICE (-524288)
@@ -140,10 +159,13 @@ extern "C" {
 #define WC_CAN_CLUTCH_SENSORS_NAME "ClutchSensors"
 #define WC_CAN_TORQUE_REQUEST_NAME "TorqueRequest"
 #define WC_CAN_SHIFT_COMMAND_NAME "ShiftCommand"
+#define WC_CAN_OFFGOING_SENSORS_NAME "OffgoingSensors"
 #define WC_CAN_VFS_COMMAND_NAME "VfsCommand"
 #define WC_CAN_CLUTCH_ESTIMATE_NAME "ClutchEstimate"
 #define WC_CAN_SHIFT_REPORT_NAME "ShiftReport"
 #define WC_CAN_ADAPTATION_REPORT_NAME "AdaptationReport"
+#define WC_CAN_OFFGOING_VFS_COMMAND_NAME "OffgoingVfsCommand"
+#define WC_CAN_ENGINE_TORQUE_REQUEST_NAME "EngineTorqueRequest"
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
 #define WC_CAN_XCP_COMMAND_NAME "XcpCommand"
 #define WC_CAN_XCP_RESPONSE_NAME "XcpResponse"
@@ -165,6 +187,9 @@ extern "C" {
 #define WC_CAN_SHIFT_COMMAND_TARGET_GEAR_NAME "TargetGear"
 #define WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_NAME "TurbineTorque"
 #define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_NAME "TargetInertiaTime"
+#define WC_CAN_OFFGOING_SENSORS_CRC_NAME "Crc"
+#define WC_CAN_OFFGOING_SENSORS_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_NAME "OffgoingSlipSpeed"
 #define WC_CAN_VFS_COMMAND_CRC_NAME "Crc"
 #define WC_CAN_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
@@ -206,6 +231,16 @@ extern "C" {
 #define WC_CAN_ADAPTATION_REPORT_CONFIDENCE_NAME "Confidence"
 #define WC_CAN_ADAPTATION_REPORT_FILM_FACTOR_NAME "FilmFactor"
 #define WC_CAN_ADAPTATION_REPORT_KISS_OFFSET_NAME "KissOffset"
+#define WC_CAN_OFFGOING_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_OFFGOING_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_OFFGOING_VFS_COMMAND_SHIFT_PHASE_NAME "ShiftPhase"
+#define WC_CAN_OFFGOING_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_OFFGOING_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_NAME "Fallback"
+#define WC_CAN_ENGINE_TORQUE_REQUEST_CRC_NAME "Crc"
+#define WC_CAN_ENGINE_TORQUE_REQUEST_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ENGINE_TORQUE_REQUEST_INTERVENTION_ACTIVE_NAME "InterventionActive"
+#define WC_CAN_ENGINE_TORQUE_REQUEST_TORQUE_DELTA_NAME "TorqueDelta"
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_NAME "LoadCellForce"
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_NAME "MeasuredTorque"
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
@@ -381,6 +416,42 @@ struct wc_can_shift_command_t {
      * Offset: 0
      */
     uint16_t target_inertia_time;
+};
+
+/**
+ * Signals in message OffgoingSensors.
+ *
+ * Off-going clutch sensor input (DESIGN 14), 1 ms. E2E protected, data id 0x13. Needed in Shift mode when the TCU controls the whole shift (shift calibration coordinator = 1); ignored otherwise.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_offgoing_sensors_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x13 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame (same rules as ClutchSensors).
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * Off-going (1st-gear) clutch slip speed w_t - i1 w_o, signed, same scaling as ClutchSensors.SlipSpeed: > 0 the turbine runs above the 1st-gear speed (flare), < 0 the on-coming clutch pulls it down (inertia phase). Raw -32768 = SNA.
+     *
+     * Range: -32000..32000 (-8000..8000 rpm)
+     * Scale: 0.25
+     * Offset: 0
+     */
+    int16_t offgoing_slip_speed;
 };
 
 /**
@@ -786,6 +857,114 @@ struct wc_can_adaptation_report_t {
      * Offset: 0
      */
     int16_t kiss_offset;
+};
+
+/**
+ * Signals in message OffgoingVfsCommand.
+ *
+ * VFS command of the off-going clutch (DESIGN 14), sent by the TCU every 1 ms step after VfsCommand when it controls the whole shift. E2E protected, data id 0x24.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_offgoing_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x24 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * The shift coordinator's phase: 0 idle, 1 prepare (fill), 2 torque, 3 inertia, 4 lock-up, 5 locked, 6 aborted (include/wetclutch/wc_shift.h).
+     *
+     * Range: 0..6 (0..6 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t shift_phase;
+
+    /**
+     * Commanded off-going VFS current, scaling as VfsCommand.VfsCurrent.
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Off-going piston pressure the command aims at (K i), scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * Fallback of a shift whose input was lost (DESIGN 14): 0 none; 1 finishing on the model (inertia phase, bounded time); 2 handed back to the off-going gear; 3 released (neither possible).
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t fallback;
+};
+
+/**
+ * Signals in message EngineTorqueRequest.
+ *
+ * Engine torque intervention request (DESIGN 14), TCU to engine, every 1 ms step when the TCU controls the whole shift. E2E protected, data id 0x25. The engine follows with its own lag and limits (or not at all); the TCU sees the result in ShiftCommand.TurbineTorque.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_engine_torque_request_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x25 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 1: apply TorqueDelta to the driver's torque; 0: no intervention (TorqueDelta 0), also in the safe state and after a lost input.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t intervention_active;
+
+    /**
+     * Requested change of the engine (turbine) torque against the driver's demand: > 0 increase (torque phase: fills the torque hole), < 0 reduction (inertia phase: less friction energy). 0.05 Nm/bit signed 16 bit, valid -1000..1000 Nm; the shift calibration limits it further (engine_increase_max, engine_reduction_max).
+     *
+     * Range: -20000..20000 (-1000..1000 Nm)
+     * Scale: 0.05
+     * Offset: 0
+     */
+    int16_t torque_delta;
 };
 
 /**
@@ -1322,6 +1501,109 @@ bool wc_can_shift_command_target_inertia_time_is_in_range(uint16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value);
+
+/**
+ * Pack message OffgoingSensors.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_offgoing_sensors_pack(
+    uint8_t *dst_p,
+    const struct wc_can_offgoing_sensors_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message OffgoingSensors.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_offgoing_sensors_unpack(
+    struct wc_can_offgoing_sensors_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from OffgoingSensors.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_offgoing_sensors_init(struct wc_can_offgoing_sensors_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_phys_range(float value);
 
 /**
  * Pack message VfsCommand.
@@ -2372,6 +2654,300 @@ bool wc_can_adaptation_report_kiss_offset_is_in_range(int16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_adaptation_report_kiss_offset_is_in_phys_range(float value);
+
+/**
+ * Pack message OffgoingVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_offgoing_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_offgoing_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message OffgoingVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_offgoing_vfs_command_unpack(
+    struct wc_can_offgoing_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from OffgoingVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_offgoing_vfs_command_init(struct wc_can_offgoing_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_shift_phase_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_shift_phase_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_fallback_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_offgoing_vfs_command_fallback_is_in_phys_range(float value);
+
+/**
+ * Pack message EngineTorqueRequest.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_engine_torque_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_engine_torque_request_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message EngineTorqueRequest.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_engine_torque_request_unpack(
+    struct wc_can_engine_torque_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from EngineTorqueRequest.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_engine_torque_request_init(struct wc_can_engine_torque_request_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_intervention_active_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_intervention_active_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_torque_delta_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_engine_torque_request_torque_delta_is_in_phys_range(float value);
 
 /**
  * Pack message BenchMeasurement.

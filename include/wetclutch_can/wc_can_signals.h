@@ -44,6 +44,7 @@ extern const wc_can_signal_t wc_can_sig_shift_command_adaptation_reset; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_gear; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_turbine_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time; /* ms */
+extern const wc_can_signal_t wc_can_sig_offgoing_sensors_offgoing_slip_speed; /* rpm */
 extern const wc_can_signal_t wc_can_sig_vfs_command_vfs_current; /* mA */
 extern const wc_can_signal_t wc_can_sig_vfs_command_pressure_command; /* kPa */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_estimated_clutch_temp; /* degC */
@@ -66,6 +67,11 @@ extern const wc_can_signal_t wc_can_sig_adaptation_report_friction_scale_change;
 extern const wc_can_signal_t wc_can_sig_adaptation_report_confidence; /* 1 */
 extern const wc_can_signal_t wc_can_sig_adaptation_report_film_factor; /* 1 */
 extern const wc_can_signal_t wc_can_sig_adaptation_report_kiss_offset; /* kPa */
+extern const wc_can_signal_t wc_can_sig_offgoing_vfs_command_shift_phase; /* 1 */
+extern const wc_can_signal_t wc_can_sig_offgoing_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_offgoing_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_engine_torque_request_intervention_active; /* 1 */
+extern const wc_can_signal_t wc_can_sig_engine_torque_request_torque_delta; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force; /* N */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
@@ -96,6 +102,12 @@ typedef struct {
     float target_inertia_time_ms;
     uint8_t alive_counter;
 } wc_can_shift_command_phys_t;
+
+/** OffgoingSensors (0x113) in physical units. */
+typedef struct {
+    float offgoing_slip_speed_rpm;
+    uint8_t alive_counter;
+} wc_can_offgoing_sensors_phys_t;
 
 /** VfsCommand (0x120) in physical units. */
 typedef struct {
@@ -139,6 +151,22 @@ typedef struct {
     float kiss_offset_kPa;
 } wc_can_adaptation_report_phys_t;
 
+/** OffgoingVfsCommand (0x124) in physical units. */
+typedef struct {
+    float shift_phase;
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    uint8_t fallback; /**< WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_offgoing_vfs_command_phys_t;
+
+/** EngineTorqueRequest (0x125) in physical units. */
+typedef struct {
+    float intervention_active;
+    float torque_delta_Nm;
+    uint8_t alive_counter;
+} wc_can_engine_torque_request_phys_t;
+
 /** BenchMeasurement (0x130) in physical units. */
 typedef struct {
     float load_cell_force_N;
@@ -166,6 +194,8 @@ wc_can_result_t wc_can_encode_torque_request(uint8_t *dst, const wc_can_torque_r
 wc_can_result_t wc_can_decode_torque_request(wc_can_torque_request_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_command_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_offgoing_sensors(uint8_t *dst, const wc_can_offgoing_sensors_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_offgoing_sensors(wc_can_offgoing_sensors_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_estimate_phys_t *src, size_t size);
@@ -174,6 +204,10 @@ wc_can_result_t wc_can_encode_shift_report(uint8_t *dst, const wc_can_shift_repo
 wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_adaptation_report(uint8_t *dst, const wc_can_adaptation_report_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_adaptation_report(wc_can_adaptation_report_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_offgoing_vfs_command(uint8_t *dst, const wc_can_offgoing_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_offgoing_vfs_command(wc_can_offgoing_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_engine_torque_request(uint8_t *dst, const wc_can_engine_torque_request_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_engine_torque_request(wc_can_engine_torque_request_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_xcp_command(uint8_t *dst, const wc_can_xcp_command_phys_t *src, size_t size);

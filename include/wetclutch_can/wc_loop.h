@@ -69,7 +69,8 @@
 
 #define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */
 #define WC_LOOP_TX_CYCLIC 2u      /* every step: VfsCommand, ClutchEstimate */
-#define WC_LOOP_TX_FRAMES 4u      /* at most: ... then ShiftReport and AdaptationReport in the step a shift ends */
+#define WC_LOOP_TX_WHOLE_SHIFT 2u /* every step too with the whole shift (DESIGN 14): OffgoingVfsCommand, EngineTorqueRequest */
+#define WC_LOOP_TX_FRAMES 6u      /* at most: ... then ShiftReport and AdaptationReport in the step a shift ends */
 
 typedef struct {
     uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit (default 10) */
@@ -86,9 +87,21 @@ typedef struct {
      * task: it must only copy or schedule (an NVM job), not block. NULL: none. */
     void (*adaptation_changed)(const wc_adapt_t *adapt, void *context);
     void *adaptation_context;
+    /* The whole shift (DESIGN 14, shift calibration coordinator = 1): the
+     * off-going clutch's own calibration (checked at init; required then).
+     * The loop then also receives OffgoingSensors (a control input in Shift
+     * mode, with the sensor timeout) and sends OffgoingVfsCommand and
+     * EngineTorqueRequest every step after ClutchEstimate. */
+    const wc_calibration_t *offgoing;
 } wc_loop_config_t;
 
-#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL, NULL, NULL }
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL, NULL, NULL, NULL }
+
+/* The whole shift runs (DESIGN 14): a shift calibration with the coordinator and the off-going clutch's calibration. */
+static inline bool wc_loop_whole_shift(const wc_loop_config_t *config)
+{
+    return (config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing != NULL);
+}
 
 typedef enum {
     WC_REJECT_CRC = 0,      /* E2E CRC mismatch */
@@ -133,7 +146,9 @@ typedef struct {
     wc_loop_input_t request_in;
     wc_loop_input_t bench_in;
     wc_loop_input_t shift_in;
+    wc_loop_input_t offgoing_in;            /* OffgoingSensors (the whole shift) */
     wc_can_clutch_sensors_phys_t sensors;   /* last valid */
+    wc_can_offgoing_sensors_phys_t offgoing_sensors;  /* last valid */
     wc_can_shift_command_phys_t shift_command;  /* last valid */
     wc_shift_t shift;                       /* the shift controller (config.shift) */
     wc_shift_report_t report;               /* the last shift's quality vector */
@@ -149,6 +164,14 @@ typedef struct {
     wc_step_output_t last;                  /* last step's model output */
     wc_step_input_t input;                  /* last step's clutch input (in Shift mode as the controller set it) */
     wc_shift_command_t command;             /* last Shift-mode step's command to the shift controller */
+    /* The whole shift (DESIGN 14; config.offgoing) */
+    wc_clutch_t offgoing;                   /* the off-going clutch */
+    wc_step_input_t offgoing_input;
+    wc_step_output_t offgoing_last;
+    bool engine_active;                     /* the engine request of the last step */
+    float engine_delta_Nm;
+    uint8_t tx_alive_offgoing;
+    uint8_t tx_alive_engine;
 } wc_loop_t;
 
 /* Validate the calibration (and the shift calibration: a failing one returns
@@ -230,7 +253,7 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
  * with config.shift), BenchMeasurement (only with bench_input_enabled). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
                          WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
-#define WC_LOOP_RX_ID_COUNT 4u
+#define WC_LOOP_RX_ID_COUNT 5u
 
 /* The receive filter of a port for this configuration: writes the ids the
  * loop uses (of WC_LOOP_RX_IDS) to ids and returns their count; a port

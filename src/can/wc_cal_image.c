@@ -10,6 +10,14 @@
 #include "generated/wc_cal_image_layout.h"
 #include "wetclutch/wc_image.h"
 
+
+/* The whole shift (DESIGN 14): an image holds one clutch calibration, which
+ * the off-going clutch shares (the same lining in these transmissions). */
+static void wc_cal_set_offgoing(wc_cal_set_t *set)
+{
+    set->loop.offgoing = ((set->loop.shift != NULL) && (set->shift.coordinator == 1u)) ? &set->clutch : NULL;
+}
+
 WC_STATIC_ASSERT(WC_CAL_IMAGE_LOOP_FIELDS == (uint32_t)WC_CAL_LOOP_ERRORS - 1u, one_limit_per_loop_code);
 WC_STATIC_ASSERT(WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED == WC_CAL_IMAGE_LOOP_BEGIN, shift_enabled_first_loop_field);
 /* the three film arrays follow each other, node i of each 4 * NODES bytes apart */
@@ -98,6 +106,7 @@ wc_cal_image_status_t wc_cal_image_decode(const uint8_t *payload, wc_cal_set_t *
     const wc_cal_image_status_t status = check(payload, set);
     if (status.result == (uint32_t)WC_CAL_IMAGE_OK) {
         set->loop.shift = set->shift_enabled ? &set->shift : NULL;
+        wc_cal_set_offgoing(set);
     } else {
         memset(set, 0, sizeof *set);  /* never a half-used calibration: wc_loop_init refuses a zero one */
     }
@@ -177,6 +186,7 @@ bool wc_cal_set_from(wc_cal_set_t *set, const wc_calibration_t *clutch, const wc
     set->loop.e2e = from->e2e;
     set->loop.recovery_periods = from->recovery_periods;
     set->loop.shift = set->shift_enabled ? &set->shift : NULL;
+    wc_cal_set_offgoing(set);
     return true;
 }
 

@@ -9,7 +9,7 @@
 /* Sizes the loop relies on. */
 WC_STATIC_ASSERT((WC_LOOP_RX_CAPACITY & (WC_LOOP_RX_CAPACITY - 1u)) == 0u, rx_ring_is_a_power_of_two);
 WC_STATIC_ASSERT(WC_LOOP_RX_CAPACITY >= 2u * WC_LOOP_RX_ID_COUNT, rx_ring_holds_two_periods_of_input);
-WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == 4u), tx_is_command_estimate_and_reports);
+WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == WC_LOOP_TX_CYCLIC + WC_LOOP_TX_WHOLE_SHIFT + 2u), tx_is_command_estimate_whole_shift_and_reports);
 WC_STATIC_ASSERT(WC_CAN_ADAPTATION_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), adaptation_report_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, shift_command_is_an_e2e_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), shift_report_fits_a_frame);
@@ -37,8 +37,15 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
         return WC_CAL_NULL;  /* wc_shift_calibration_check says which field */
     }
+    if ((config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing == NULL)) {
+        return WC_CAL_NULL;  /* the whole shift needs the off-going clutch's calibration */
+    }
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
     if (error != WC_CAL_OK) { return error; }
+    if (wc_loop_whole_shift(config)) {
+        const wc_cal_error_t offgoing_error = wc_clutch_init(&loop->offgoing, config->offgoing, theta_start_degC);
+        if (offgoing_error != WC_CAL_OK) { return offgoing_error; }
+    }
     wc_shift_init(&loop->shift);
     wc_adapt_reset(&loop->adapt);
     loop->adapt.status = WC_ADAPT_STATUS_IMAGE_MISSING;  /* until wc_loop_load_adaptation */
@@ -47,6 +54,7 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     input_reset(&loop->request_in);
     input_reset(&loop->bench_in);
     input_reset(&loop->shift_in);
+    input_reset(&loop->offgoing_in);
     loop->sensors.oil_temp_degC = theta_start_degC;
     loop->sensors.housing_temp_degC = theta_start_degC;
     loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
@@ -60,9 +68,18 @@ wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal,
     if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
         return WC_CAL_NULL;
     }
+    /* the whole shift cannot be switched on or off online, nor run without the off-going calibration */
+    if (wc_loop_whole_shift(config) != wc_loop_whole_shift(&loop->config)) { return WC_CAL_NULL; }
+    if ((config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing == NULL)) { return WC_CAL_NULL; }
     wc_model_t model;
     const wc_cal_error_t error = wc_model_init(&model, cal);  /* the check and the constants derived once */
     if (error != WC_CAL_OK) { return error; }
+    if (wc_loop_whole_shift(config)) {
+        wc_model_t offgoing_model;
+        const wc_cal_error_t offgoing_error = wc_model_init(&offgoing_model, config->offgoing);
+        if (offgoing_error != WC_CAL_OK) { return offgoing_error; }
+        loop->offgoing.model = offgoing_model;
+    }
     loop->clutch.model = model;
     const wc_loop_config_t kept = loop->config;
     loop->config = *config;
@@ -188,6 +205,10 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
         wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_shift_command(&c, f->data, f->dlc);
         if (accept(loop, &loop->shift_in, r, true, c.alive_counter)) { loop->shift_command = c; }
+    } else if ((f->id == WC_CAN_OFFGOING_SENSORS_FRAME_ID) && wc_loop_whole_shift(&loop->config)) {
+        wc_can_offgoing_sensors_phys_t o = {0.0f, 0u};
+        const wc_can_result_t r = wc_can_decode_offgoing_sensors(&o, f->data, f->dlc);
+        if (accept(loop, &loop->offgoing_in, r, true, o.alive_counter)) { loop->offgoing_sensors = o; }
     } else if ((f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) && loop->config.bench_input_enabled) {
         wc_can_bench_measurement_phys_t b = {0.0f, 0.0f, 0.0f};
         const wc_can_result_t r = wc_can_decode_bench_measurement(&b, f->data, f->dlc);
@@ -323,6 +344,36 @@ static WC_NOINLINE void encode_outputs(wc_loop_t *loop, uint16_t bits, wc_can_fr
 
 }
 
+/* The whole shift's cyclic frames (DESIGN 14) after ClutchEstimate at out[n]:
+ * OffgoingVfsCommand, EngineTorqueRequest. Returns the new count. */
+static WC_NOINLINE uint32_t encode_whole_shift(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES], uint32_t n)
+{
+    const wc_step_output_t *o = &loop->offgoing_last;
+    const wc_can_offgoing_vfs_command_phys_t command = {
+        .vfs_current_mA = o->current_mA,
+        .pressure_command_kPa = o->pressure_command_Pa * 1.0e-3f,
+        .shift_phase = (float)loop->shift.phase,
+        .fallback = (uint8_t)loop->shift.fallback,
+        .alive_counter = loop->tx_alive_offgoing,
+    };
+    loop->tx_alive_offgoing = wc_e2e_counter_next(loop->tx_alive_offgoing);
+    out[n].id = WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID;
+    out[n].dlc = WC_CAN_OFFGOING_VFS_COMMAND_LENGTH;
+    out[n].flags = 0u;
+    (void)wc_can_encode_offgoing_vfs_command(out[n].data, &command, sizeof out[n].data);
+    const wc_can_engine_torque_request_phys_t engine = {
+        .intervention_active = loop->engine_active ? 1.0f : 0.0f,
+        .torque_delta_Nm = loop->engine_active ? loop->engine_delta_Nm : 0.0f,
+        .alive_counter = loop->tx_alive_engine,
+    };
+    loop->tx_alive_engine = wc_e2e_counter_next(loop->tx_alive_engine);
+    out[n + 1u].id = WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID;
+    out[n + 1u].dlc = WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH;
+    out[n + 1u].flags = 0u;
+    (void)wc_can_encode_engine_torque_request(out[n + 1u].data, &engine, sizeof out[n + 1u].data);
+    return n + WC_LOOP_TX_WHOLE_SHIFT;
+}
+
 /* What prepare() found for the model step and finish(), with this period's
  * status bits (bits 0..15, WC_CAN_STATUS_*) in one word. */
 #define STEP_SHIFT (1uL << 16)   /* the shift controller steps the clutch */
@@ -372,6 +423,12 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
         shift_mode) {
         step |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
+    /* The whole shift (DESIGN 14): in Shift mode OffgoingSensors is a sensor input too. */
+    if (wc_loop_whole_shift(&loop->config) &&
+        update_freshness(&loop->offgoing_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts) &&
+        shift_mode) {
+        step |= WC_CAN_STATUS_SENSOR_TIMEOUT;
+    }
     /* Debounce: both control inputs fresh for recovery_periods in a row. */
     const bool fresh = (step & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
     loop->fresh_periods = fresh ? ((loop->fresh_periods < UINT32_MAX) ? loop->fresh_periods + 1u : UINT32_MAX) : 0u;
@@ -398,6 +455,14 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     in->correction.friction_scale_delta = 0.0f;  /* the shift controller sets it (DESIGN 12) */
     in->correction.film_factor_delta = 0.0f;
     in->correction.kiss_offset_N = 0.0f;
+    if (wc_loop_whole_shift(&loop->config)) {  /* the off-going clutch's sensors; the controller sets the rest */
+        wc_step_input_t *og = &loop->offgoing_input;
+        og->slip_rad_s = loop->offgoing_sensors.offgoing_slip_speed_rpm * WC_RAD_S_PER_RPM;
+        og->theta_oil_degC = in->theta_oil_degC;
+        og->theta_housing_degC = in->theta_housing_degC;
+        og->mode = WC_MODE_OPEN;
+        og->torque_request_Nm = 0.0f;
+    }
     if (bench_fresh) { step |= WC_CAN_STATUS_BENCH_INPUT; }
     if (safe) {
         step |= WC_CAN_STATUS_SAFE_STATE_ACTIVE | STEP_SAFE;
@@ -435,6 +500,7 @@ static uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOO
 {
     encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
+    if (wc_loop_whole_shift(&loop->config)) { n = encode_whole_shift(loop, out, n); }
     if ((step & STEP_REPORT) != 0u) { encode_report(&loop->report, &out[n++]); }
     if ((step & STEP_ADAPT) != 0u) {
         encode_adaptation(&loop->report.adaptation, loop->adapt.status, &out[n++]);
@@ -458,14 +524,25 @@ static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bo
     WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
     uint32_t step = prepare(loop);
     if ((step & STEP_SHIFT) != 0u) {
-        if (wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u, &loop->clutch,
-                          &loop->adapt, &loop->input, &loop->last, &loop->report)) {
+        wc_shift_offgoing_t offgoing = { &loop->offgoing, &loop->offgoing_input, &loop->offgoing_last, false, 0.0f };
+        const bool whole = wc_loop_whole_shift(&loop->config);
+        const bool ended = wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u,
+                                         &loop->clutch, &loop->adapt, &loop->input, &loop->last, &loop->report,
+                                         whole ? &offgoing : NULL);
+        loop->engine_active = offgoing.engine_active;
+        loop->engine_delta_Nm = offgoing.engine_delta_Nm;
+        if (ended) {
             step |= STEP_REPORT;
             /* adaptation on: what the shift changed goes out with the report (the hook persists it) */
             if (loop->config.shift->adaptation == 1u) { step |= STEP_ADAPT; }
         }
     } else {
         (void)wc_clutch_step(&loop->clutch, &loop->input, &loop->last);  /* its status is loop->last.status */
+        if (wc_loop_whole_shift(&loop->config)) {  /* not in Shift mode: the off-going clutch is not ours: open */
+            (void)wc_clutch_step(&loop->offgoing, &loop->offgoing_input, &loop->offgoing_last);
+            loop->engine_active = false;
+            loop->engine_delta_Nm = 0.0f;
+        }
     }
     return finish(loop, step, out);
 }
@@ -497,6 +574,7 @@ uint32_t wc_loop_rx_ids(const wc_loop_config_t *config, uint32_t ids[WC_LOOP_RX_
     ids[n++] = WC_CAN_CLUTCH_SENSORS_FRAME_ID;
     ids[n++] = WC_CAN_TORQUE_REQUEST_FRAME_ID;
     if (config->shift != NULL) { ids[n++] = WC_CAN_SHIFT_COMMAND_FRAME_ID; }
+    if (wc_loop_whole_shift(config)) { ids[n++] = WC_CAN_OFFGOING_SENSORS_FRAME_ID; }
     if (config->bench_input_enabled) { ids[n++] = WC_CAN_BENCH_MEASUREMENT_FRAME_ID; }
     return n;
 }

@@ -86,6 +86,11 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(adapt_film_gain), SHIFT_FIELD(adapt_kiss_band_Pa), SHIFT_FIELD(adapt_kiss_step_Pa),
     SHIFT_FIELD(adapt_kiss_gain), SHIFT_FIELD(adapt_window_skip_s), SHIFT_FIELD(adapt_film_window_s),
     SHIFT_FIELD(adapt_min_slip_drop), SHIFT_FIELD(adapt_min_conditioning),
+    SHIFT_FIELD(offgoing_ratio), SHIFT_FIELD(fill_pulse_current_mA), SHIFT_FIELD(fill_pulse_time_s),
+    SHIFT_FIELD(offgoing_holding_factor), SHIFT_FIELD(offgoing_margin_factor), SHIFT_FIELD(offgoing_lag_compensation_time_s),
+    SHIFT_FIELD(flare_kp_Nm_per_rad_s), SHIFT_FIELD(flare_ki_Nm_per_rad), SHIFT_FIELD(handover_slip_rad_s),
+    SHIFT_FIELD(engine_increase_max_Nm), SHIFT_FIELD(engine_reduction_max_Nm), SHIFT_FIELD(engine_fill_fraction),
+    SHIFT_FIELD(engine_reduction_fraction), SHIFT_FIELD(engine_recovery_time_s), SHIFT_FIELD(fallback_time_s),
 };
 
 static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
@@ -198,6 +203,9 @@ int main(int argc, char **argv)
             return 2;
         }
         config.shift = &shift;
+    }
+    if ((config.shift != NULL) && (config.shift->coordinator == 1u) && (config.offgoing == NULL)) {
+        config.offgoing = cal;  /* DESIGN 14: the off-going clutch has the same lining (its own instance) */
     }
     if (wc_loop_init(&loop, cal, &config, (float)theta_start_degC) != WC_CAL_OK) {
         fprintf(stderr, "wc_replay: calibration %s rejected\n", calibration);

@@ -57,7 +57,25 @@ static bool in_closed(float value, float lo, float hi) { return (value >= lo) &&
     X(adapt_window_skip_s, WC_SHIFT_CAL_ADAPT_WINDOW_SKIP, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
     X(adapt_film_window_s, WC_SHIFT_CAL_ADAPT_FILM_WINDOW, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
     X(adapt_min_slip_drop, WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP, 0u, 0.0f, 1.0f) \
-    X(adapt_min_conditioning, WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING, 0u, 0.0f, 1.0f)
+    X(adapt_min_conditioning, WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING, 0u, 0.0f, 1.0f) \
+    X(coordinator, WC_SHIFT_CAL_COORDINATOR, WC_FIELD_INTEGER, 0.0f, 1.0f) \
+    X(offgoing_ratio, WC_SHIFT_CAL_OFFGOING_RATIO, WC_FIELD_OR_ZERO, 0.05f, 20.0f) \
+    X(fill_pulse_current_mA, WC_SHIFT_CAL_FILL_PULSE_CURRENT, 0u, 0.0f, WC_SHIFT_LIMIT_CURRENT_MAX_mA) \
+    X(fill_pulse_time_s, WC_SHIFT_CAL_FILL_PULSE_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(offgoing_holding_factor, WC_SHIFT_CAL_OFFGOING_HOLDING_FACTOR, 0u, 0.0f, 5.0f) \
+    X(offgoing_margin_factor, WC_SHIFT_CAL_OFFGOING_MARGIN_FACTOR, 0u, 0.0f, 1.0f) \
+    X(offgoing_lag_compensation_time_s, WC_SHIFT_CAL_OFFGOING_LAG_COMPENSATION_TIME, WC_FIELD_OR_ZERO, 1e-3f, \
+      WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(flare_kp_Nm_per_rad_s, WC_SHIFT_CAL_FLARE_KP, 0u, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX) \
+    X(flare_ki_Nm_per_rad, WC_SHIFT_CAL_FLARE_KI, 0u, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX) \
+    X(handover_slip_rad_s, WC_SHIFT_CAL_HANDOVER_SLIP, 0u, 0.0f, WC_SLIP_MAX_rad_s) \
+    X(engine_intervention, WC_SHIFT_CAL_ENGINE_INTERVENTION, WC_FIELD_INTEGER, 0.0f, 1.0f) \
+    X(engine_increase_max_Nm, WC_SHIFT_CAL_ENGINE_INCREASE_MAX, 0u, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm) \
+    X(engine_reduction_max_Nm, WC_SHIFT_CAL_ENGINE_REDUCTION_MAX, 0u, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm) \
+    X(engine_fill_fraction, WC_SHIFT_CAL_ENGINE_FILL_FRACTION, 0u, 0.0f, 1.0f) \
+    X(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0u, 0.0f, 1.0f) \
+    X(engine_recovery_time_s, WC_SHIFT_CAL_ENGINE_RECOVERY_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(fallback_time_s, WC_SHIFT_CAL_FALLBACK_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s)
 
 #define WC_SHIFT_RANGE(member, code, flags, low, high) { (low), (high) },
 #define WC_SHIFT_FLAGS(member, code, flags, low, high) (uint8_t)(flags),
@@ -78,17 +96,18 @@ wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *ca
 {
     if (cal == NULL) { return WC_SHIFT_CAL_NULL; }
     const uint32_t i = wc_field_first_invalid(cal, &field_rules);
-    return (i < field_rules.count) ? (wc_shift_cal_error_t)((uint32_t)WC_SHIFT_CAL_TURBINE_INERTIA + i) : WC_SHIFT_CAL_OK;
+    if (i < field_rules.count) { return (wc_shift_cal_error_t)((uint32_t)WC_SHIFT_CAL_TURBINE_INERTIA + i); }
+    /* DESIGN 14: the off-going gear is the lower one (its slip turns negative in the inertia phase) */
+    if ((cal->coordinator == 1u) && !(cal->offgoing_ratio > cal->output_ratio)) { return WC_SHIFT_CAL_OFFGOING_RATIO; }
+    if (cal->fill_pulse_time_s > cal->prepare_time_s) { return WC_SHIFT_CAL_FILL_PULSE_TIME; }
+    return WC_SHIFT_CAL_OK;
 }
 
 void wc_shift_init(wc_shift_t *shift)
 {
     WC_ASSERT(shift != NULL);
     if (shift == NULL) { return; }
-    static const wc_shift_t idle = { 0u, 0u, false, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u, 0u,
-                                     { 0.0f, 0.0f },
-                                     { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, false, false, 0u,
-                                       { 0u, 0u, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f } } };
+    static const wc_shift_t idle;  /* all zero: IDLE, no report, no fallback */
     *shift = idle;
 }
 
@@ -171,25 +190,44 @@ static bool command_valid(const wc_shift_calibration_t *cal, const wc_shift_comm
            in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm);
 }
 
+/* The whole shift (DESIGN 14) runs when the calibration asks for it and the
+ * caller gave the off-going clutch. */
+static bool coordinated(const wc_shift_calibration_t *cal, const wc_shift_offgoing_t *offgoing)
+{
+    return (cal->coordinator == 1u) && (offgoing != NULL) && (offgoing->clutch != NULL) && (offgoing->in != NULL) &&
+           (offgoing->out != NULL);
+}
+
 static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s,
-                  const wc_lag_compensation_t *lag, wc_adapt_t *adapt)
+                  const wc_lag_compensation_t *lag, const wc_lag_compensation_t *offgoing_lag, wc_adapt_t *adapt)
 {
     wc_shift_init(shift);
     wc_adapt_begin(adapt);  /* a new window (NULL: none) */
     shift->lag_compensation = *lag;  /* its exponential once per shift, not per step */
+    shift->offgoing_lag = *offgoing_lag;
     shift->last_request = true;
     shift->turbine_torque_Nm = command->turbine_torque_Nm;
+    shift->driver_torque_Nm = command->turbine_torque_Nm;  /* T_t0: before any intervention (DESIGN 14) */
     shift->target_time_s = command->target_inertia_time_s;
     shift->start_slip_rad_s = slip_rad_s;
     shift->report.peak_theta_degC = WC_THETA_MIN_degC;
     enter(shift, WC_SHIFT_PREPARE);
 }
 
+/* The inertia phase's end: the reference has run out (fallback: on the
+ * model, the slip is not known). */
+static void enter_lockup(wc_shift_t *shift, float elapsed_s)
+{
+    shift->report.inertia_time_s = elapsed_s;
+    shift->phase_start_request_Nm = shift->request_Nm;
+    enter(shift, WC_SHIFT_LOCKUP);
+}
+
 /* The torque request of this period (the phase's law); may change the phase.
  * d: the driveline terms of this step, carried_Nm the feed-forward at a zero
- * slip rate. */
+ * slip rate. coord: the whole shift (DESIGN 14). */
 static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s,
-                              float dt_s, bool saturated, const wc_driveline_t *d, float carried_Nm)
+                              float dt_s, bool saturated, const wc_driveline_t *d, float carried_Nm, bool coord)
 {
     const float share_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;  /* T_t / a */
     if (shift->phase == (uint32_t)WC_SHIFT_PREPARE) {
@@ -198,12 +236,16 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     }
     if (shift->phase == (uint32_t)WC_SHIFT_TORQUE) {
         const uint32_t n = periods_of(cal->torque_phase_time_s, dt_s);
-        if (shift->phase_periods < n) {
+        /* DESIGN 14: the off-going clutch slips backwards, so the on-coming clutch holds the turbine (the
+         * speeds show the tie-up): the torque phase is over, the off-going clutch is released */
+        const bool handed_over = coord && (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s);
+        if ((shift->phase_periods < n) && !handed_over) {
             return share_Nm * (float)(shift->phase_periods + 1u) / (float)n;
         }
         /* inertia phase: the reference starts at the measured slip; bumpless:
          * the integral takes what the feed-forward does not give of the last request */
         enter(shift, WC_SHIFT_INERTIA);
+        shift->second_gear = coord;
         shift->start_slip_rad_s = slip_rad_s;
         shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * carried_Nm;
         if (!(slip_rad_s > cal->min_start_slip_rad_s)) {
@@ -216,6 +258,10 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         const float elapsed_s = (float)shift->phase_periods * dt_s;
         const float reference = reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
         const float ff_Nm = cal->feedforward_gain * feedforward_Nm(d, rate_rad_s2);
+        if (shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE) {
+            /* DESIGN 14: the slip is not known: the feed-forward on the reference, the integral frozen */
+            return ff_Nm + shift->integral_Nm;
+        }
         const float error = slip_rad_s - reference;  /* slip above the reference: more torque */
         shift->error_sq_sum += error * error;
         shift->inertia_periods++;
@@ -232,14 +278,43 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         }
         return ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
     }
+    /* DESIGN 14: the hold covers the driver's torque while the engine's reduction ramps out */
+    const float hold_share_Nm = (coord && (shift->driver_torque_Nm > shift->turbine_torque_Nm))
+                                    ? (shift->driver_torque_Nm / cal->turbine_ratio) : share_Nm;
     if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
         const uint32_t n = periods_of(cal->lockup_ramp_time_s, dt_s);
-        const float hold_Nm = cal->holding_torque_factor * share_Nm;
+        const float hold_Nm = cal->holding_torque_factor * hold_share_Nm;
         const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
         return shift->phase_start_request_Nm + (hold_Nm - shift->phase_start_request_Nm) * ((x < 1.0f) ? x : 1.0f);
     }
     /* LOCKED: hold */
-    return cal->holding_torque_factor * share_Nm;
+    return cal->holding_torque_factor * hold_share_Nm;
+}
+
+/* A lost input (the loop's safe state) with the coordinator (DESIGN 14): the
+ * fallback of the phase, the engine request withdrawn (engine_request). */
+static void fall_back(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
+{
+    if (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) {
+        if ((shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_TORQUE)) {
+            /* the off-going clutch still has the gear: hand it back */
+            shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_HANDBACK;
+            shift->report.fallback = shift->fallback;
+            abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
+            return;
+        }
+        shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_FINISH;  /* inertia phase or later: finish on the model */
+        shift->report.fallback = shift->fallback;
+    }
+    if ((float)shift->fallback_periods * dt_s > cal->fallback_time_s) {
+        shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_RELEASED;  /* neither possible: released */
+        shift->report.fallback = shift->fallback;
+        if (wc_shift_phase_running(shift->phase)) {
+            abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
+        } else {
+            enter(shift, WC_SHIFT_IDLE);  /* LOCKED: released; the off-going clutch stays open (second gear) */
+        }
+    }
 }
 
 /* Before the clutch step: the transitions on the command and the loop's
@@ -247,29 +322,37 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
  * compensation, temperature source). saturated: the last step's output was. */
 static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                          bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
-                         wc_adapt_t *adapt, wc_step_input_t *in)
+                         wc_adapt_t *adapt, wc_step_input_t *in, const wc_shift_offgoing_t *offgoing)
 {
+    const bool coord = coordinated(cal, offgoing);
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
 
     /* Transitions on the command and the loop's state. */
-    if (safe || !command->request) {
+    if (coord && safe && (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED))) {
+        fall_back(shift, cal, dt_s);  /* DESIGN 14: not released at once */
+    } else if (safe || !command->request) {
         if (wc_shift_phase_running(shift->phase)) {
             abort_shift(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
         } else if (!command->request || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
             enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
+            if (!safe) { shift->second_gear = false; }  /* withdrawn: the VCU takes 1st gear back (DESIGN 14) */
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
         if (command_valid(cal, command)) {
             const wc_lag_compensation_t lag = wc_lag_compensation(clutch, cal->lag_compensation_time_s);
-            start(shift, command, slip_rad_s, &lag, adapt);
+            const wc_lag_compensation_t off = coord ? wc_lag_compensation(offgoing->clutch,
+                                                                          cal->offgoing_lag_compensation_time_s)
+                                                    : shift->offgoing_lag;
+            start(shift, command, slip_rad_s, &lag, &off, adapt);
         } else {  /* nothing of the command is kept (it may hold NaN) */
             wc_shift_init(shift);
             shift->last_request = true;
             abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
         }
     }
-    if (wc_shift_phase_running(shift->phase) && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+    const bool follow = wc_shift_phase_running(shift->phase) || (coord && (shift->phase == (uint32_t)WC_SHIFT_IDLE));
+    if (follow && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
 
@@ -292,7 +375,8 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         /* once synchronous the clutch carries what the driveline model says
          * (the feed-forward at a zero slip rate), not the request */
         const float carried_Nm = feedforward_Nm(&d, 0.0f);
-        const float request_Nm = clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm));
+        const float request_Nm = clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm,
+                                                                  coord));
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
             in->mode = WC_MODE_TORQUE;
             in->torque_request_Nm = request_Nm;
@@ -300,6 +384,92 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
             in->carried_torque_Nm = carried_Nm;
         }
     }
+}
+
+/* The engine's torque request of this step (DESIGN 14): torque phase, an
+ * increase with the on-coming clutch's ramp that fills part of the torque
+ * hole (b1 - b) / b * T_t0; inertia phase, from it to a reduction of the
+ * driver's torque with the reference (smoothstep), which cuts the friction
+ * energy; after it the reduction ramps out in engine_recovery_time_s. 0 and
+ * inactive otherwise, and in a fallback. */
+static void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, wc_shift_offgoing_t *og)
+{
+    float delta_Nm = 0.0f;
+    bool active = (cal->engine_intervention == 1u) && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
+    const float t0_Nm = shift->driver_torque_Nm;
+    const float hole_Nm = cal->engine_fill_fraction * (cal->offgoing_ratio - cal->output_ratio) / cal->output_ratio * t0_Nm;
+    const float increase_Nm = (hole_Nm < cal->engine_increase_max_Nm) ? hole_Nm : cal->engine_increase_max_Nm;
+    const float cut_Nm = cal->engine_reduction_fraction * t0_Nm;
+    const float reduction_Nm = (cut_Nm < cal->engine_reduction_max_Nm) ? cut_Nm : cal->engine_reduction_max_Nm;
+    const uint32_t phase = shift->phase;
+    if (phase == (uint32_t)WC_SHIFT_TORQUE) {
+        const uint32_t n = periods_of(cal->torque_phase_time_s, dt_s);
+        const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
+        delta_Nm = increase_Nm * ((x < 1.0f) ? x : 1.0f);
+        shift->recovery_periods = 0u;
+    } else if (phase == (uint32_t)WC_SHIFT_INERTIA) {
+        const float x = (float)shift->phase_periods * dt_s / shift->target_time_s;  /* target >= 0.05 s (checked) */
+        const float xc = (x < 1.0f) ? x : 1.0f;
+        const float s = xc * xc * (3.0f - 2.0f * xc);  /* the reference's smoothstep (DESIGN 10) */
+        delta_Nm = increase_Nm * (1.0f - s) - reduction_Nm * s;
+        shift->engine_from_Nm = delta_Nm;
+        shift->recovery_periods = 0u;
+    } else if ((phase == (uint32_t)WC_SHIFT_LOCKUP) || (phase == (uint32_t)WC_SHIFT_LOCKED)) {
+        const float t_s = (float)shift->recovery_periods * dt_s;
+        const float y = (cal->engine_recovery_time_s > 0.0f) ? (t_s / cal->engine_recovery_time_s) : 1.0f;
+        active = active && (y < 1.0f);
+        delta_Nm = shift->engine_from_Nm * (1.0f - ((y < 1.0f) ? y : 1.0f));
+        shift->recovery_periods = (shift->recovery_periods < UINT32_MAX) ? (shift->recovery_periods + 1u) : UINT32_MAX;
+    } else {
+        active = false;
+    }
+    shift->engine_delta_Nm = active ? delta_Nm : 0.0f;
+    og->engine_active = active;
+    og->engine_delta_Nm = shift->engine_delta_Nm;
+}
+
+/* The off-going clutch's input and step (DESIGN 14): it holds 1st gear at
+ * offgoing_holding_factor * T_t until the torque phase; there its request is
+ * the torque it still carries, T_t - a T_c (T_c the on-coming model's torque
+ * of this step), plus offgoing_margin_factor * T_t0 and the flare correction
+ * (PI on the off-going slip above 0: the turbine runs up); released from the
+ * inertia phase on (second gear). A hand-back (an abort before the inertia
+ * phase) and IDLE in the safe state hold it at the maximum current. */
+static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, bool safe, float oncoming_torque_Nm,
+                          float dt_s, wc_shift_offgoing_t *og)
+{
+    wc_step_input_t *in = og->in;
+    const uint32_t phase = shift->phase;
+    const float t_t_Nm = shift->turbine_torque_Nm;
+    in->mode = WC_MODE_OPEN;
+    in->torque_request_Nm = 0.0f;
+    in->carried_torque_Nm = 0.0f;
+    in->lag_compensation = shift->offgoing_lag;
+    in->theta_from_oil = false;
+    const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
+    in->correction = none;
+    if (!shift->second_gear) {
+        if (safe || (phase == (uint32_t)WC_SHIFT_ABORTED)) {
+            in->mode = WC_MODE_LOCKED;  /* hold the gear without inputs (hand-back) */
+        } else if ((phase == (uint32_t)WC_SHIFT_IDLE) || (phase == (uint32_t)WC_SHIFT_PREPARE)) {
+            in->mode = WC_MODE_TORQUE;
+            in->torque_request_Nm = clamp_torque_Nm(cal->offgoing_holding_factor * t_t_Nm);
+            in->carried_torque_Nm = clamp_torque_Nm(t_t_Nm);
+        } else if (phase == (uint32_t)WC_SHIFT_TORQUE) {
+            const float carried_Nm = clamp_torque_Nm(t_t_Nm - cal->turbine_ratio * oncoming_torque_Nm);
+            const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
+            const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
+            shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
+            if (flare_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
+            in->mode = WC_MODE_TORQUE;
+            in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm +
+                                                    cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
+            in->carried_torque_Nm = carried_Nm;
+        } else {
+            /* INERTIA .. LOCKED without second gear: cannot happen (set on entering INERTIA); open */
+        }
+    }
+    (void)wc_clutch_step(og->clutch, in, og->out);
 }
 
 /* After the clutch step: the lock-up decides the inertia phase's end, the
@@ -310,7 +480,8 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
 {
     const uint32_t phase_stepped = shift->phase;
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
-    if ((shift->phase == (uint32_t)WC_SHIFT_INERTIA) && (cal->adaptation == 1u)) {
+    const bool fallback = shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE;
+    if ((shift->phase == (uint32_t)WC_SHIFT_INERTIA) && (cal->adaptation == 1u) && !fallback) {
         /* DESIGN 12: the window's sample of this period (its torque against the slip's change) */
         const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
         wc_adapt_sample(adapt, cal, (float)shift->phase_periods * dt_s, slip_rad_s, d.drive_rad_s2,
@@ -327,20 +498,19 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
          * torque there) is pulled in by the hand-over's force, not left to the
          * integral; far from it the inertia phase goes on (and may time out) */
         const bool reference_ended = (elapsed_s >= shift->target_time_s) &&
-                                     (fabsf(slip_rad_s) <= cal->min_start_slip_rad_s);
-        if (locked || synchronous || reference_ended) {
-            shift->report.inertia_time_s = elapsed_s;
-            shift->phase_start_request_Nm = shift->request_Nm;
-            enter(shift, WC_SHIFT_LOCKUP);
+                                     (fallback || (fabsf(slip_rad_s) <= cal->min_start_slip_rad_s));
+        if ((!fallback && (locked || synchronous)) || reference_ended) {
+            enter_lockup(shift, elapsed_s);
         } else if (elapsed_s > shift->target_time_s * cal->inertia_timeout_factor) {
             shift->report.inertia_time_s = elapsed_s;
             abort_shift(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
         }
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
         /* locked once the ramp is done (the lock-up's dwell and the film may end
-         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times */
+         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times; in a fallback the
+         * ramp's end (the slip is not known) */
         const uint32_t ramp = periods_of(cal->lockup_ramp_time_s, dt_s);
-        if (locked && (shift->phase_periods + 1u >= ramp)) { enter(shift, WC_SHIFT_LOCKED); }
+        if ((locked || fallback) && (shift->phase_periods + 1u >= ramp)) { enter(shift, WC_SHIFT_LOCKED); }
         else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
             abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
         }
@@ -373,9 +543,29 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
     return ended;
 }
 
+/* The fill pulse (DESIGN 14): in the prepare phase's first fill_pulse_time_s
+ * the VFS gets fill_pulse_current_mA to stroke the piston fast; the model
+ * steps at the kiss point meanwhile (request 0), which is what the chamber
+ * holds while the piston strokes against its spring. */
+static void fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
+                       float dt_s, wc_step_output_t *out)
+{
+    const wc_calibration_t *c = clutch->model.cal;
+    if ((c == NULL) || (shift->phase != (uint32_t)WC_SHIFT_PREPARE) ||
+        (shift->phase_periods > periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
+        return;
+    }
+    const float i = cal->fill_pulse_current_mA;
+    const float i_mA = (i < c->vfs_current_min_mA) ? c->vfs_current_min_mA : ((i > c->vfs_current_max_mA) ? c->vfs_current_max_mA : i);
+    if (i_mA > out->current_mA) {
+        out->current_mA = i_mA;
+        out->pressure_command_Pa = c->vfs_gain_Pa_per_mA * i_mA;
+    }
+}
+
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                    bool safe, wc_clutch_t *clutch, wc_adapt_t *adapt, wc_step_input_t *in, wc_step_output_t *out,
-                   wc_shift_report_t *report)
+                   wc_shift_report_t *report, wc_shift_offgoing_t *offgoing)
 {
     WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (in != NULL) &&
               (out != NULL) && (report != NULL));
@@ -383,12 +573,31 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         (out == NULL) || (report == NULL)) {
         return false;
     }
+    const bool coord = coordinated(cal, offgoing);
     const uint32_t phase_before = shift->phase;
     const float dt_s = (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;  /* init failed: any */
     /* the measured slip, or while it is invalid the clutch's last valid one */
     const float slip_rad_s = wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
     const bool saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's output */
-    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in);
+    if (coord) {
+        const float s = offgoing->in->slip_rad_s;
+        shift->offgoing_slip_rad_s = wc_slip_valid(s) ? s : offgoing->clutch->held.slip_rad_s;
+        if (safe) {
+            shift->fallback_periods = (shift->fallback_periods < UINT32_MAX) ? (shift->fallback_periods + 1u) : UINT32_MAX;
+        } else if (!wc_shift_phase_running(shift->phase)) {
+            shift->fallback_periods = 0u;
+        }
+    }
+    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
     (void)wc_clutch_step(clutch, in, out);
-    return shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
+    if (coord) {
+        fill_pulse(shift, cal, clutch, dt_s, out);
+        offgoing_step(shift, cal, safe, out->model.torque_Nm, dt_s, offgoing);
+        engine_request(shift, cal, dt_s, offgoing);
+    }
+    const bool ended = shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
+    if (coord && ended && (shift->phase == (uint32_t)WC_SHIFT_ABORTED) && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE)) {
+        report->fallback = (uint32_t)(shift->second_gear ? WC_SHIFT_FALLBACK_NONE : WC_SHIFT_FALLBACK_HANDBACK);
+    }
+    return ended;
 }

@@ -476,6 +476,9 @@ int main(int argc, char **argv)
         }
     }
     config.bench_input_enabled = opt.bench != 0;
+    if ((config.shift != NULL) && (config.shift->coordinator == 1u) && (config.offgoing == NULL)) {
+        config.offgoing = cal;  /* DESIGN 14: the off-going clutch has the same lining (its own instance) */
+    }
     const wc_cal_error_t cal_error = wc_loop_init(&loop, cal, &config, (float)opt.theta_start_degC);
     if (cal_error != WC_CAL_OK) {
         fprintf(stderr, "wc_tcu: calibration %s invalid: field %s\n", opt.calibration, wc_cal_error_name(cal_error));

@@ -19,6 +19,10 @@ const wc_tcu_shift_calibration_t wc_tcu_shift_calibrations[] = {
     {"shift_1_2_feedback", &wc_shift_1_2_feedback},  /* (a) PI only */
     {"shift_1_2_nolag", &wc_shift_1_2_nolag},        /* (c) without lag compensation */
     {"shift_1_2_adaptive", &wc_shift_1_2_adaptive},  /* (c) with adaptation (DESIGN 12) */
+    /* the whole shift (DESIGN 14): fill, off-going clutch, engine intervention */
+    {"shift_1_2_whole_full", &wc_shift_1_2_whole_full},          /* (c) */
+    {"shift_1_2_whole_blind", &wc_shift_1_2_whole_blind},        /* (b) */
+    {"shift_1_2_whole_feedback", &wc_shift_1_2_whole_feedback},  /* (a) */
 };
 const size_t wc_tcu_shift_calibration_count = sizeof wc_tcu_shift_calibrations / sizeof wc_tcu_shift_calibrations[0];
 

@@ -74,6 +74,23 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(adapt_film_window_s, WC_SHIFT_CAL_ADAPT_FILM_WINDOW, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
     SHIFT_FIELD(adapt_min_slip_drop, WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP, 0.0f, 1.0f, false),
     SHIFT_FIELD(adapt_min_conditioning, WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING, 0.0f, 1.0f, false),
+    /* the whole shift (DESIGN 14); coordinator and engine_intervention are tested on their own */
+    SHIFT_FIELD(offgoing_ratio, WC_SHIFT_CAL_OFFGOING_RATIO, 0.05f, 20.0f, true),
+    SHIFT_FIELD(fill_pulse_current_mA, WC_SHIFT_CAL_FILL_PULSE_CURRENT, 0.0f, WC_SHIFT_LIMIT_CURRENT_MAX_mA, false),
+    SHIFT_FIELD(fill_pulse_time_s, WC_SHIFT_CAL_FILL_PULSE_TIME, 0.0f, 0.05f, false),  /* <= test_cal's prepare time */
+    SHIFT_FIELD(offgoing_holding_factor, WC_SHIFT_CAL_OFFGOING_HOLDING_FACTOR, 0.0f, 5.0f, false),
+    SHIFT_FIELD(offgoing_margin_factor, WC_SHIFT_CAL_OFFGOING_MARGIN_FACTOR, 0.0f, 1.0f, false),
+    SHIFT_FIELD(offgoing_lag_compensation_time_s, WC_SHIFT_CAL_OFFGOING_LAG_COMPENSATION_TIME, 1e-3f,
+                WC_SHIFT_LIMIT_TIME_MAX_s, true),
+    SHIFT_FIELD(flare_kp_Nm_per_rad_s, WC_SHIFT_CAL_FLARE_KP, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX, false),
+    SHIFT_FIELD(flare_ki_Nm_per_rad, WC_SHIFT_CAL_FLARE_KI, 0.0f, WC_SHIFT_LIMIT_GAIN_MAX, false),
+    SHIFT_FIELD(handover_slip_rad_s, WC_SHIFT_CAL_HANDOVER_SLIP, 0.0f, WC_SLIP_MAX_rad_s, false),
+    SHIFT_FIELD(engine_increase_max_Nm, WC_SHIFT_CAL_ENGINE_INCREASE_MAX, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm, false),
+    SHIFT_FIELD(engine_reduction_max_Nm, WC_SHIFT_CAL_ENGINE_REDUCTION_MAX, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm, false),
+    SHIFT_FIELD(engine_fill_fraction, WC_SHIFT_CAL_ENGINE_FILL_FRACTION, 0.0f, 1.0f, false),
+    SHIFT_FIELD(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0.0f, 1.0f, false),
+    SHIFT_FIELD(engine_recovery_time_s, WC_SHIFT_CAL_ENGINE_RECOVERY_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
+    SHIFT_FIELD(fallback_time_s, WC_SHIFT_CAL_FALLBACK_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
 };
 
 /* The fields with a rule of their own (test_calibration_adaptation_rules): the
@@ -83,9 +100,10 @@ static bool tested_on_its_own(int code)
 {
     return (code == (int)WC_SHIFT_CAL_THETA_SOURCE) || (code == (int)WC_SHIFT_CAL_ADAPTATION) ||
            ((code >= (int)WC_SHIFT_CAL_ADAPT_THETA_NODE0) && (code <= (int)WC_SHIFT_CAL_ADAPT_THETA_NODE4)) ||
-           (code == (int)WC_SHIFT_CAL_ADAPT_SCALE_BAND);
+           (code == (int)WC_SHIFT_CAL_ADAPT_SCALE_BAND) || (code == (int)WC_SHIFT_CAL_COORDINATOR) ||
+           (code == (int)WC_SHIFT_CAL_ENGINE_INTERVENTION);
 }
-#define ON_ITS_OWN_WORDS (2u + WC_ADAPT_NODES + 1u)
+#define ON_ITS_OWN_WORDS (2u + WC_ADAPT_NODES + 1u + 2u)
 
 static float *shift_field_ptr(wc_shift_calibration_t *cal, size_t offset)
 {
@@ -166,6 +184,30 @@ static void test_calibration_each_field_rejected(void **state)
 /* DESIGN 12: adaptation 0 or 1; the nodes within the thermal envelope and
  * strictly increasing (a node equal to the one before it is rejected with its
  * own code); the scale band in (0, WC_CORRECTION_SCALE_MAX]. */
+/* The whole shift's own rules (DESIGN 14): the integer switches, and with the
+ * coordinator an off-going ratio above the on-coming one. */
+static void test_calibration_whole_shift_rules(void **state)
+{
+    (void)state;
+    wc_shift_calibration_t cal = test_cal;
+    cal.engine_intervention = 1u;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
+    cal.engine_intervention = 2u;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_ENGINE_INTERVENTION);
+    cal = test_cal;
+    cal.coordinator = 2u;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_COORDINATOR);
+    cal.coordinator = 1u;
+    cal.offgoing_ratio = 0.0f;  /* off (0) is not a ratio for the coordinator */
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
+    cal.offgoing_ratio = cal.output_ratio;  /* the off-going gear must be the lower one */
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
+    cal.offgoing_ratio = cal.output_ratio * 1.5f;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
+    cal.offgoing_ratio = NAN;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
+}
+
 static void test_calibration_adaptation_rules(void **state)
 {
     (void)state;
@@ -380,6 +422,7 @@ int main(void)
         cmocka_unit_test(test_calibration_each_field_rejected),
         cmocka_unit_test(test_calibration_limits_inclusive),
         cmocka_unit_test(test_calibration_adaptation_rules),
+        cmocka_unit_test(test_calibration_whole_shift_rules),
         cmocka_unit_test(test_reference_ends),
         cmocka_unit_test(test_reference_monotone_and_rate),
         cmocka_unit_test(test_feedforward_formula),

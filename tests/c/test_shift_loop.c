@@ -316,7 +316,7 @@ static void test_loop_adaptation_report_hook_and_reset(void **state)
         const uint32_t n = adaptive_period(&l, 1, k >= 200, 1.2f, &a, &had);
         if (had) {
             reports++;
-            assert_int_equal(n, WC_LOOP_TX_FRAMES);  /* VfsCommand, ClutchEstimate, ShiftReport, AdaptationReport */
+            assert_int_equal(n, WC_LOOP_TX_CYCLIC + 2u);  /* VfsCommand, ClutchEstimate, ShiftReport, AdaptationReport */
             assert_int_equal(l.out[2].id, WC_CAN_SHIFT_REPORT_FRAME_ID);
         }
     }

@@ -73,7 +73,7 @@ static bool sim_step_sensor(sim_t *s, const wc_shift_command_t *command, bool sa
     sensors.slip_rad_s = sensor_slip;
     sensors.theta_oil_degC = sensor_oil;
     sensors.theta_housing_degC = THETA_OIL_degC;
-    const bool ended = wc_shift_step(&s->shift, s->cal, command, safe, &s->clutch, NULL, &sensors, &s->out, &s->report);
+    const bool ended = wc_shift_step(&s->shift, s->cal, command, safe, &s->clutch, NULL, &sensors, &s->out, &s->report, NULL);
     if (ended) { s->ended++; }
     const uint32_t phase = s->shift.phase;
     if (phase != s->phase_log[s->phase_log_len - 1u]) {

@@ -83,8 +83,25 @@ WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, adapt_window_skip_s) == WC_CAL
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, adapt_film_window_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_FILM_WINDOW_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_adapt_film_window_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, adapt_min_slip_drop) == WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_SLIP_DROP - WC_CAL_IMAGE_SHIFT_BEGIN, shift_adapt_min_slip_drop_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, adapt_min_conditioning) == WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_CONDITIONING - WC_CAL_IMAGE_SHIFT_BEGIN, shift_adapt_min_conditioning_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, coordinator) == WC_CAL_IMAGE_OFFSET_SHIFT_COORDINATOR - WC_CAL_IMAGE_SHIFT_BEGIN, shift_coordinator_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, offgoing_ratio) == WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_RATIO - WC_CAL_IMAGE_SHIFT_BEGIN, shift_offgoing_ratio_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, fill_pulse_current_mA) == WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_CURRENT_MA - WC_CAL_IMAGE_SHIFT_BEGIN, shift_fill_pulse_current_mA_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, fill_pulse_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_fill_pulse_time_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, offgoing_holding_factor) == WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_HOLDING_FACTOR - WC_CAL_IMAGE_SHIFT_BEGIN, shift_offgoing_holding_factor_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, offgoing_margin_factor) == WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_MARGIN_FACTOR - WC_CAL_IMAGE_SHIFT_BEGIN, shift_offgoing_margin_factor_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, offgoing_lag_compensation_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_LAG_COMPENSATION_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_offgoing_lag_compensation_time_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, flare_kp_Nm_per_rad_s) == WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KP_NM_PER_RAD_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_flare_kp_Nm_per_rad_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, flare_ki_Nm_per_rad) == WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KI_NM_PER_RAD - WC_CAL_IMAGE_SHIFT_BEGIN, shift_flare_ki_Nm_per_rad_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, handover_slip_rad_s) == WC_CAL_IMAGE_OFFSET_SHIFT_HANDOVER_SLIP_RAD_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_handover_slip_rad_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_intervention) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INTERVENTION - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_intervention_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_increase_max_Nm) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INCREASE_MAX_NM - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_increase_max_Nm_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_reduction_max_Nm) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_MAX_NM - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_reduction_max_Nm_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_fill_fraction) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_fill_fraction_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_reduction_fraction) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_reduction_fraction_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_recovery_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_recovery_time_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, fallback_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_fallback_time_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == 120u, every_clutch_field_in_the_layout);
-WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == 172u, every_shift_field_in_the_layout);
+WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == 240u, every_shift_field_in_the_layout);
 
 void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
 {
@@ -169,6 +186,23 @@ void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_FILM_WINDOW_S], set->shift.adapt_film_window_s);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_SLIP_DROP], set->shift.adapt_min_slip_drop);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_CONDITIONING], set->shift.adapt_min_conditioning);
+    wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_COORDINATOR], set->shift.coordinator);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_RATIO], set->shift.offgoing_ratio);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_CURRENT_MA], set->shift.fill_pulse_current_mA);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_TIME_S], set->shift.fill_pulse_time_s);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_HOLDING_FACTOR], set->shift.offgoing_holding_factor);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_MARGIN_FACTOR], set->shift.offgoing_margin_factor);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_LAG_COMPENSATION_TIME_S], set->shift.offgoing_lag_compensation_time_s);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KP_NM_PER_RAD_S], set->shift.flare_kp_Nm_per_rad_s);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KI_NM_PER_RAD], set->shift.flare_ki_Nm_per_rad);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_HANDOVER_SLIP_RAD_S], set->shift.handover_slip_rad_s);
+    wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INTERVENTION], set->shift.engine_intervention);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INCREASE_MAX_NM], set->shift.engine_increase_max_Nm);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_MAX_NM], set->shift.engine_reduction_max_Nm);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION], set->shift.engine_fill_fraction);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION], set->shift.engine_reduction_fraction);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S], set->shift.engine_recovery_time_s);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S], set->shift.fallback_time_s);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED], set->shift_enabled ? 1u : 0u);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS], set->loop.sensor_timeout_periods);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_REQUEST_TIMEOUT_PERIODS], set->loop.request_timeout_periods);
@@ -260,6 +294,23 @@ void wc_cal_image_layout_decode(const uint8_t *payload, wc_cal_set_t *set)
     set->shift.adapt_film_window_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_FILM_WINDOW_S]);
     set->shift.adapt_min_slip_drop = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_SLIP_DROP]);
     set->shift.adapt_min_conditioning = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_CONDITIONING]);
+    set->shift.coordinator = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_COORDINATOR]);
+    set->shift.offgoing_ratio = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_RATIO]);
+    set->shift.fill_pulse_current_mA = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_CURRENT_MA]);
+    set->shift.fill_pulse_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_TIME_S]);
+    set->shift.offgoing_holding_factor = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_HOLDING_FACTOR]);
+    set->shift.offgoing_margin_factor = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_MARGIN_FACTOR]);
+    set->shift.offgoing_lag_compensation_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_LAG_COMPENSATION_TIME_S]);
+    set->shift.flare_kp_Nm_per_rad_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KP_NM_PER_RAD_S]);
+    set->shift.flare_ki_Nm_per_rad = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KI_NM_PER_RAD]);
+    set->shift.handover_slip_rad_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_HANDOVER_SLIP_RAD_S]);
+    set->shift.engine_intervention = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INTERVENTION]);
+    set->shift.engine_increase_max_Nm = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INCREASE_MAX_NM]);
+    set->shift.engine_reduction_max_Nm = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_MAX_NM]);
+    set->shift.engine_fill_fraction = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION]);
+    set->shift.engine_reduction_fraction = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION]);
+    set->shift.engine_recovery_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S]);
+    set->shift.fallback_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S]);
     set->shift_enabled = (wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED]) != 0u);
     set->loop.sensor_timeout_periods = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS]);
     set->loop.request_timeout_periods = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_REQUEST_TIMEOUT_PERIODS]);
@@ -357,6 +408,23 @@ static const field_name_t field_names[] = {
     { WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_FILM_WINDOW_S, 4u, "shift.adapt_film_window_s" },
     { WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_SLIP_DROP, 4u, "shift.adapt_min_slip_drop" },
     { WC_CAL_IMAGE_OFFSET_SHIFT_ADAPT_MIN_CONDITIONING, 4u, "shift.adapt_min_conditioning" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_COORDINATOR, 4u, "shift.coordinator" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_RATIO, 4u, "shift.offgoing_ratio" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_CURRENT_MA, 4u, "shift.fill_pulse_current_mA" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_FILL_PULSE_TIME_S, 4u, "shift.fill_pulse_time_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_HOLDING_FACTOR, 4u, "shift.offgoing_holding_factor" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_MARGIN_FACTOR, 4u, "shift.offgoing_margin_factor" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_OFFGOING_LAG_COMPENSATION_TIME_S, 4u, "shift.offgoing_lag_compensation_time_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KP_NM_PER_RAD_S, 4u, "shift.flare_kp_Nm_per_rad_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_FLARE_KI_NM_PER_RAD, 4u, "shift.flare_ki_Nm_per_rad" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_HANDOVER_SLIP_RAD_S, 4u, "shift.handover_slip_rad_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INTERVENTION, 4u, "shift.engine_intervention" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_INCREASE_MAX_NM, 4u, "shift.engine_increase_max_Nm" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_MAX_NM, 4u, "shift.engine_reduction_max_Nm" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION, 4u, "shift.engine_fill_fraction" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION, 4u, "shift.engine_reduction_fraction" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S, 4u, "shift.engine_recovery_time_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S, 4u, "shift.fallback_time_s" },
     { WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED, 4u, "loop.shift_enabled" },
     { WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS, 4u, "loop.sensor_timeout_periods" },
     { WC_CAL_IMAGE_OFFSET_LOOP_REQUEST_TIMEOUT_PERIODS, 4u, "loop.request_timeout_periods" },

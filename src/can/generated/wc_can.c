@@ -447,6 +447,89 @@ bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value)
     return ((value >= 50.0f) && (value <= 2000.0f));
 }
 
+int wc_can_offgoing_sensors_pack(
+    uint8_t *dst_p,
+    const struct wc_can_offgoing_sensors_t *src_p,
+    size_t size)
+{
+    uint16_t offgoing_slip_speed;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    offgoing_slip_speed = (uint16_t)src_p->offgoing_slip_speed;
+    dst_p[2] |= pack_left_shift_u16(offgoing_slip_speed, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(offgoing_slip_speed, 8u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_offgoing_sensors_unpack(
+    struct wc_can_offgoing_sensors_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    uint16_t offgoing_slip_speed;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    offgoing_slip_speed = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    offgoing_slip_speed |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->offgoing_slip_speed = (int16_t)offgoing_slip_speed;
+
+    return (0);
+}
+
+int wc_can_offgoing_sensors_init(struct wc_can_offgoing_sensors_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_offgoing_sensors_t));
+
+    return 0;
+}
+
+bool wc_can_offgoing_sensors_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_offgoing_sensors_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_offgoing_sensors_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_offgoing_sensors_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_range(int16_t value)
+{
+    return ((value >= -32000) && (value <= 32000));
+}
+
+bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_phys_range(float value)
+{
+    return ((value >= -8000.0f) && (value <= 8000.0f));
+}
+
 int wc_can_vfs_command_pack(
     uint8_t *dst_p,
     const struct wc_can_vfs_command_t *src_p,
@@ -1143,6 +1226,216 @@ bool wc_can_adaptation_report_kiss_offset_is_in_range(int16_t value)
 }
 
 bool wc_can_adaptation_report_kiss_offset_is_in_phys_range(float value)
+{
+    return ((value >= -1000.0f) && (value <= 1000.0f));
+}
+
+int wc_can_offgoing_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_offgoing_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->shift_phase, 4u, 0x70u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u8(src_p->fallback, 0u, 0x03u);
+
+    return (8);
+}
+
+int wc_can_offgoing_vfs_command_unpack(
+    struct wc_can_offgoing_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->shift_phase = unpack_right_shift_u8(src_p[1], 4u, 0x70u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->fallback = unpack_right_shift_u8(src_p[6], 0u, 0x03u);
+
+    return (0);
+}
+
+int wc_can_offgoing_vfs_command_init(struct wc_can_offgoing_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_offgoing_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_offgoing_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_offgoing_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_offgoing_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_offgoing_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_offgoing_vfs_command_shift_phase_is_in_range(uint8_t value)
+{
+    return (value <= 6u);
+}
+
+bool wc_can_offgoing_vfs_command_shift_phase_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 6.0f));
+}
+
+bool wc_can_offgoing_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_offgoing_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_offgoing_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_offgoing_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_offgoing_vfs_command_fallback_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_offgoing_vfs_command_fallback_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+int wc_can_engine_torque_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_engine_torque_request_t *src_p,
+    size_t size)
+{
+    uint16_t torque_delta;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->intervention_active, 4u, 0x10u);
+    torque_delta = (uint16_t)src_p->torque_delta;
+    dst_p[2] |= pack_left_shift_u16(torque_delta, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(torque_delta, 8u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_engine_torque_request_unpack(
+    struct wc_can_engine_torque_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    uint16_t torque_delta;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->intervention_active = unpack_right_shift_u8(src_p[1], 4u, 0x10u);
+    torque_delta = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    torque_delta |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->torque_delta = (int16_t)torque_delta;
+
+    return (0);
+}
+
+int wc_can_engine_torque_request_init(struct wc_can_engine_torque_request_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_engine_torque_request_t));
+
+    return 0;
+}
+
+bool wc_can_engine_torque_request_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_engine_torque_request_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_engine_torque_request_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_engine_torque_request_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_engine_torque_request_intervention_active_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_engine_torque_request_intervention_active_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_engine_torque_request_torque_delta_is_in_range(int16_t value)
+{
+    return ((value >= -20000) && (value <= 20000));
+}
+
+bool wc_can_engine_torque_request_torque_delta_is_in_phys_range(float value)
 {
     return ((value >= -1000.0f) && (value <= 1000.0f));
 }

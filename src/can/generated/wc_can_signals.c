@@ -42,6 +42,10 @@ const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 50, .raw_max = 2000,
     .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .has_sna = true,
 };
+const wc_can_signal_t wc_can_sig_offgoing_sensors_offgoing_slip_speed = {
+    .scale = 0.25f, .offset = 0.0f, .raw_min = -32000, .raw_max = 32000,
+    .raw_nan = (int32_t)WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE, .has_sna = true,
+};
 const wc_can_signal_t wc_can_sig_vfs_command_vfs_current = {
     .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
@@ -128,6 +132,26 @@ const wc_can_signal_t wc_can_sig_adaptation_report_film_factor = {
 };
 const wc_can_signal_t wc_can_sig_adaptation_report_kiss_offset = {
     .scale = 0.25f, .offset = 0.0f, .raw_min = -4000, .raw_max = 4000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_offgoing_vfs_command_shift_phase = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 6,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_offgoing_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_offgoing_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_engine_torque_request_intervention_active = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_engine_torque_request_torque_delta = {
+    .scale = 0.05f, .offset = 0.0f, .raw_min = -20000, .raw_max = 20000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
 const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force = {
@@ -302,6 +326,45 @@ wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, co
     dst->target_gear = to_phys(&wc_can_sig_shift_command_target_gear, msg.target_gear, &result);
     dst->turbine_torque_Nm = to_phys(&wc_can_sig_shift_command_turbine_torque, msg.turbine_torque, &result);
     dst->target_inertia_time_ms = to_phys(&wc_can_sig_shift_command_target_inertia_time, msg.target_inertia_time, &result);
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* OffgoingSensors (E2E) */
+
+wc_can_result_t wc_can_encode_offgoing_sensors(uint8_t *dst, const wc_can_offgoing_sensors_phys_t *src, size_t size)
+{
+    struct wc_can_offgoing_sensors_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_OFFGOING_SENSORS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.offgoing_slip_speed = (int16_t)to_raw(&wc_can_sig_offgoing_sensors_offgoing_slip_speed, src->offgoing_slip_speed_rpm, &result);
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_offgoing_sensors_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_OFFGOING_SENSORS_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_offgoing_sensors(wc_can_offgoing_sensors_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_offgoing_sensors_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_OFFGOING_SENSORS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_OFFGOING_SENSORS_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_offgoing_sensors_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->offgoing_slip_speed_rpm = to_phys(&wc_can_sig_offgoing_sensors_offgoing_slip_speed, msg.offgoing_slip_speed, &result);
     dst->alive_counter = msg.alive_counter;
     return result;
 }
@@ -493,6 +556,96 @@ wc_can_result_t wc_can_decode_adaptation_report(wc_can_adaptation_report_phys_t 
     dst->confidence = to_phys(&wc_can_sig_adaptation_report_confidence, msg.confidence, &result);
     dst->film_factor = to_phys(&wc_can_sig_adaptation_report_film_factor, msg.film_factor, &result);
     dst->kiss_offset_kPa = to_phys(&wc_can_sig_adaptation_report_kiss_offset, msg.kiss_offset, &result);
+    return result;
+}
+
+/* OffgoingVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_offgoing_vfs_command(uint8_t *dst, const wc_can_offgoing_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_offgoing_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_OFFGOING_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.shift_phase = (uint8_t)to_raw(&wc_can_sig_offgoing_vfs_command_shift_phase, src->shift_phase, &result);
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_offgoing_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_offgoing_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.fallback = (uint8_t)(src->fallback & 0x03u);
+    if (src->fallback > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_offgoing_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_offgoing_vfs_command(wc_can_offgoing_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_offgoing_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_OFFGOING_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_offgoing_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->shift_phase = to_phys(&wc_can_sig_offgoing_vfs_command_shift_phase, msg.shift_phase, &result);
+    dst->vfs_current_mA = to_phys(&wc_can_sig_offgoing_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_offgoing_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->fallback = msg.fallback;
+    if (!wc_can_offgoing_vfs_command_fallback_is_in_range(msg.fallback)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* EngineTorqueRequest (E2E) */
+
+wc_can_result_t wc_can_encode_engine_torque_request(uint8_t *dst, const wc_can_engine_torque_request_phys_t *src, size_t size)
+{
+    struct wc_can_engine_torque_request_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.intervention_active = (uint8_t)to_raw(&wc_can_sig_engine_torque_request_intervention_active, src->intervention_active, &result);
+    msg.torque_delta = (int16_t)to_raw(&wc_can_sig_engine_torque_request_torque_delta, src->torque_delta_Nm, &result);
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_engine_torque_request_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_engine_torque_request(wc_can_engine_torque_request_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_engine_torque_request_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_engine_torque_request_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->intervention_active = to_phys(&wc_can_sig_engine_torque_request_intervention_active, msg.intervention_active, &result);
+    dst->torque_delta_Nm = to_phys(&wc_can_sig_engine_torque_request_torque_delta, msg.torque_delta, &result);
+    dst->alive_counter = msg.alive_counter;
     return result;
 }
 

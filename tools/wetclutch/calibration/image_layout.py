@@ -216,6 +216,23 @@ _SHIFT = {
     "adapt_film_window_s": (0.0, _T, "", "the film factor's early part of the window"),
     "adapt_min_slip_drop": (0.0, 1.0, "", "excitation: the slip falls by this fraction of its window start"),
     "adapt_min_conditioning": (0.0, 1.0, "", "the kiss point's least squares: D / (S11 S22) at least this"),
+    "coordinator": (0, 1, "", "1: the whole shift (off-going clutch, fill, engine; DESIGN 14)"),
+    "offgoing_ratio": (0.0, 20.0, "0 or >= 0.05; with the coordinator > output_ratio", "b1 = i1: the off-going clutch's ratio"),
+    "fill_pulse_current_mA": (0.0, shift_rules.CURRENT_MAX_MA, "", "fill pulse current"),
+    "fill_pulse_time_s": (0.0, _T, "<= prepare_time_s", "fill pulse time"),
+    "offgoing_holding_factor": (0.0, 5.0, "", "off-going capacity request before the torque phase / T_t"),
+    "offgoing_margin_factor": (0.0, 1.0, "", "torque phase: off-going request = carried + factor * T_t0"),
+    "offgoing_lag_compensation_time_s": (0.0, _T, "0 (off) or >= 0.001", "the off-going clutch's lag compensation time"),
+    "flare_kp_Nm_per_rad_s": (0.0, shift_rules.GAIN_MAX, "", "flare correction: proportional gain on the off-going slip"),
+    "flare_ki_Nm_per_rad": (0.0, shift_rules.GAIN_MAX, "", "flare correction: integral gain"),
+    "handover_slip_rad_s": (0.0, shift_rules.SLIP_MAX_RAD_S, "", "off-going slip below -this: released (tie-up)"),
+    "engine_intervention": (0, 1, "", "1: request engine torque (EngineTorqueRequest)"),
+    "engine_increase_max_Nm": (0.0, shift_rules.ENGINE_DELTA_MAX_NM, "", "torque phase: engine increase limit"),
+    "engine_reduction_max_Nm": (0.0, shift_rules.ENGINE_DELTA_MAX_NM, "", "inertia phase: engine reduction limit"),
+    "engine_fill_fraction": (0.0, 1.0, "", "torque phase: fraction of the torque hole filled by the engine"),
+    "engine_reduction_fraction": (0.0, 1.0, "", "inertia phase: reduction / T_t0"),
+    "engine_recovery_time_s": (0.0, _T, "", "the reduction ramps out in this time after the inertia phase"),
+    "fallback_time_s": (0.0, _T, "", "lost input in the inertia phase or later: finish on the model this long at most"),
 }
 
 

@@ -34,6 +34,8 @@ THETA_MIN_DEGC, THETA_MAX_DEGC = -40.0, 250.0   # WC_THETA_MIN_degC, WC_THETA_MA
 ADAPT_NODES = 5            # WC_ADAPT_NODES
 CORRECTION_SCALE_MAX = 0.5  # WC_CORRECTION_SCALE_MAX
 KISS_BAND_MAX_PA = 1e6     # WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa
+CURRENT_MAX_MA = 2000.0    # WC_SHIFT_LIMIT_CURRENT_MAX_mA
+ENGINE_DELTA_MAX_NM = 1000.0  # WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm
 
 # (name in the file, unit, C field, check) in the C struct's order. check(value, values) -> bool.
 FIELDS: tuple[tuple[str, str, str, object], ...] = (
@@ -80,8 +82,28 @@ FIELDS: tuple[tuple[str, str, str, object], ...] = (
     ("adapt_film_window", "s", "adapt_film_window_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
     ("adapt_min_slip_drop", "1", "adapt_min_slip_drop", lambda v, c: 0.0 <= v <= 1.0),
     ("adapt_min_conditioning", "1", "adapt_min_conditioning", lambda v, c: 0.0 <= v <= 1.0),
+    # The whole shift (DESIGN 14, wc_shift.h): coordinator 0 = the on-coming clutch alone
+    ("coordinator", "1", "coordinator", lambda v, c: v in (0, 1)),
+    ("offgoing_ratio", "1", "offgoing_ratio",
+     lambda v, c: (v == 0.0 or 0.05 <= v <= 20.0) and (c["coordinator"] == 0 or v > c["output_ratio"])),
+    ("fill_pulse_current", "mA", "fill_pulse_current_mA", lambda v, c: 0.0 <= v <= CURRENT_MAX_MA),
+    ("fill_pulse_time", "s", "fill_pulse_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S and v <= c["prepare_time"]),
+    ("offgoing_holding_factor", "1", "offgoing_holding_factor", lambda v, c: 0.0 <= v <= 5.0),
+    ("offgoing_margin_factor", "1", "offgoing_margin_factor", lambda v, c: 0.0 <= v <= 1.0),
+    ("offgoing_lag_compensation_time", "s", "offgoing_lag_compensation_time_s",
+     lambda v, c: v == 0.0 or 1e-3 <= v <= TIME_MAX_S),
+    ("flare_kp", "Nm/(rad/s)", "flare_kp_Nm_per_rad_s", lambda v, c: 0.0 <= v <= GAIN_MAX),
+    ("flare_ki", "Nm/rad", "flare_ki_Nm_per_rad", lambda v, c: 0.0 <= v <= GAIN_MAX),
+    ("handover_slip", "rad/s", "handover_slip_rad_s", lambda v, c: 0.0 <= v <= SLIP_MAX_RAD_S),
+    ("engine_intervention", "1", "engine_intervention", lambda v, c: v in (0, 1)),
+    ("engine_increase_max", "Nm", "engine_increase_max_Nm", lambda v, c: 0.0 <= v <= ENGINE_DELTA_MAX_NM),
+    ("engine_reduction_max", "Nm", "engine_reduction_max_Nm", lambda v, c: 0.0 <= v <= ENGINE_DELTA_MAX_NM),
+    ("engine_fill_fraction", "1", "engine_fill_fraction", lambda v, c: 0.0 <= v <= 1.0),
+    ("engine_reduction_fraction", "1", "engine_reduction_fraction", lambda v, c: 0.0 <= v <= 1.0),
+    ("engine_recovery_time", "s", "engine_recovery_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("fallback_time", "s", "fallback_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
 )
-INTEGER_FIELDS = ("theta_source", "adaptation")
+INTEGER_FIELDS = ("theta_source", "adaptation", "coordinator", "engine_intervention")
 THETA_SOURCES = {0: "observer", 1: "oil"}
 
 
