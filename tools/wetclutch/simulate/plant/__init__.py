@@ -32,6 +32,31 @@ the torque it carries at the start, holding_min), kinetic capacity
 kinetic_ratio x that; scripted release: full until release_start after the
 shift command, then linearly to 0 over release_time.
 
+The whole shift (issue 22, DESIGN 14), each part off unless asked for, so that step(i, t) and a plant file
+without the new parameters are bit for bit the plant before it:
+
+  off-going clutch on its own VFS (step(..., offgoing_current_mA=i_off); constructor offgoing_current_mA the
+      steady current before the first step): pressure P_off = K_off i_off through the lag tau_off (exact
+      within the step), static capacity offgoing_friction_scale x static_friction_factor mu2 (1 + mu3
+      (theta_oil - theta1) / theta2) x N_c R_eff x max(P_off A_p - F_s, 0) of the [offgoing] calibration
+      (default: the [clutch] one), kinetic = kinetic_ratio x static. None: the scripted release above (its
+      truth pressure/current then those of the equivalent capacity).
+  engine (step(..., engine_request_Nm=delta)): the actual turbine torque follows clip(turbine_torque_Nm +
+      delta, engine_torque_min, engine_torque_max) after engine_delay (whole periods) through the lag
+      engine_time_constant (exact, the substeps' mid values); engine_ignores_request: delta taken as 0.
+      None: the engine torque is turbine_torque_Nm at once (as before).
+  on-coming fill ([hydraulics] fill_volume > 0): the piston's stroke fraction f = x / x_max,
+      df/dt = clip(fill_flow_gain (P_vfs - P_s(f)), +-fill_flow_max) / fill_volume, P_s(f) = F_s / A_p
+      (0.8 + 0.2 f) the return spring's pressure; no apply force before f = 1 (the kiss point), then as
+      above; the piston retracts when P_vfs falls below the spring's pressure. The chamber pressure
+      (truth pressure_Pa) is the spring's while filling, the lagged VFS pressure (vfs_pressure_Pa) once full.
+  sensors: offgoing_slip_rpm (with the off-going current; its noise from a second generator).
+  truth: engine_torque_Nm, engine_request_Nm, offgoing_current_mA, offgoing_pressure_Pa, fill_fraction,
+      output_torque_Nm (i2 T_c + i1 T_off), vfs_pressure_Pa appended; turbine_torque_Nm = the actual engine torque.
+
+Plant files may extend a base (extends = "base.toml"): tools/plants/vehicles/ is a family of vehicles on
+nominal.toml (params has the rules; wetclutch.generate.vehicle_cal their TCU driveline models).
+
 Stick-slip (each clutch): a locked clutch carries the torque the rigid
 constraint needs (the constrained two-inertia system solved for it, the other
 clutch's torque known) while that is within its static capacity, else it breaks

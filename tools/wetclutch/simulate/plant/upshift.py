@@ -537,7 +537,10 @@ class UpshiftPlant:
 
     def sensors(self) -> dict:
         """What the TCU receives this period (the state now): slip_rpm (noisy, 0.25 rpm steps), oil_degC,
-        housing_degC (0.1 degC steps), turbine_torque_estimate_Nm (biased, noisy). Idempotent."""
+        housing_degC (0.1 degC steps), turbine_torque_estimate_Nm (the actual engine torque, biased, noisy);
+        with the off-going slip sensor (constructed with offgoing_current_mA, or offgoing_slip_sensor=True)
+        also offgoing_slip_rpm (w_t - i1 w_o, as slip_rpm; its noise from a second generator, so the other
+        channels are bit for bit those without it). Idempotent."""
         return dict(self._sensors)
 
     @property
@@ -564,7 +567,8 @@ def initial_turbine_speed_rpm(params: PlantParams, *, oil_degC: float, turbine_t
     for _ in range(2):
         pl = UpshiftPlant(params, oil_degC=oil_degC, turbine_torque_Nm=turbine_torque_Nm,
                           turbine_speed_rpm=start, **kwargs)
+        off = kwargs.get("offgoing_current_mA")        # the whole shift: the TCU holds 1st gear
         for _ in range(n):
-            pl.step(0.0, None)
+            pl.step(0.0, None, off)
         start -= pl.truth["turbine_speed_rpm"] - target
     return start
