@@ -64,8 +64,9 @@ static const wc_shift_calibration_t wc_shift_1_2_full = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -128,8 +129,9 @@ static const wc_shift_calibration_t wc_shift_1_2_blind = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -192,8 +194,9 @@ static const wc_shift_calibration_t wc_shift_1_2_feedback = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -256,8 +259,9 @@ static const wc_shift_calibration_t wc_shift_1_2_adaptive = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -320,8 +324,9 @@ static const wc_shift_calibration_t wc_shift_1_2_whole_full = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -384,8 +389,9 @@ static const wc_shift_calibration_t wc_shift_1_2_whole_blind = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -448,8 +454,9 @@ static const wc_shift_calibration_t wc_shift_1_2_whole_feedback = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 
@@ -512,8 +519,9 @@ static const wc_shift_calibration_t wc_shift_1_2_nolag = {
     .engine_increase_max_Nm = 60.0f, /* Nm; torque phase: at most +60 Nm (spark/boost reserve of a 2.0 l turbo at full load; the plant's engine limit decides the rest) */
     .engine_reduction_max_Nm = 150.0f, /* Nm; inertia phase: at most -150 Nm (ignition retard) */
     .engine_fill_fraction = 0.5f, /* 1; torque phase: the engine fills half the torque hole (i1 - i2) / i2 T_t0, within the limit */
-    .engine_reduction_fraction = 0.3f, /* 1; inertia phase: -30 % of T_t0 at the reference's end: the on-coming clutch's friction energy about 20 % lower */
+    .engine_reduction_fraction = 1.0f, /* 1; inertia phase: the engine takes the turbine's inertia torque I_t |dref/dt| out of the on-coming clutch: the output torque stays level instead of humping and stepping at lock-up, and the clutch's friction energy falls by that torque times the slip */
     .engine_recovery_time_s = 0.3f, /* s; after the inertia phase the reduction ramps out in 0.3 s (about one shuffle period of the 2nd gear, 3.7 Hz: no step) */
+    .engine_lead_time_s = 0.09f, /* s; the nominal engine follows a request after 10 ms with an 80 ms lag (tools/plants/vehicles/nominal.toml): asked 90 ms ahead, its torque falls with the inertia torque, not after it */
     .fallback_time_s = 1.0f, /* s; a lost input in the inertia phase: finish on the model (0.5 s target + hand-over) and hold 2nd gear up to 1 s, then release */
 };
 

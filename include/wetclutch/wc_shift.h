@@ -134,8 +134,9 @@ typedef struct wc_shift_calibration {
     float engine_increase_max_Nm;      /* torque phase: increase <= this */
     float engine_reduction_max_Nm;     /* inertia phase: reduction <= this */
     float engine_fill_fraction;        /* torque phase: increase = fraction * (b1 - b) / b * T_t0 (the torque hole) */
-    float engine_reduction_fraction;   /* inertia phase: reduction = fraction * T_t0, reached with the reference */
-    float engine_recovery_time_s;      /* after the inertia phase the reduction ramps out in this time */
+    float engine_reduction_fraction;   /* inertia phase: reduction = fraction * I_t |dref/dt| / a (the inertia torque), <= 2 */
+    float engine_recovery_time_s;      /* after the inertia phase what is left of the request ramps out in this time */
+    float engine_lead_time_s;          /* the request runs this far ahead of the reference (the engine's lag and delay) */
     float fallback_time_s;             /* a lost input in the inertia phase or later: finish on the model this long at most */
 } wc_shift_calibration_t;
 
@@ -203,6 +204,7 @@ typedef enum {
     WC_SHIFT_CAL_ENGINE_FILL_FRACTION,
     WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION,
     WC_SHIFT_CAL_ENGINE_RECOVERY_TIME,
+    WC_SHIFT_CAL_ENGINE_LEAD_TIME,
     WC_SHIFT_CAL_FALLBACK_TIME,
     WC_SHIFT_CAL_ERRORS
 } wc_shift_cal_error_t;
@@ -299,6 +301,8 @@ typedef struct {
     uint32_t fallback_periods;     /* periods since the input was lost */
     uint32_t recovery_periods;     /* periods since the engine's recovery began */
     float offgoing_slip_rad_s;     /* this step's off-going slip (measured, else the clutch's last valid) */
+    float last_slip_rad_s;         /* the on-coming slip of the last step */
+    float slip_rate_rad_s2;        /* its rate, filtered (jerk_filter_time_s): in 1st gear the turbine's acceleration */
     bool second_gear;              /* the on-coming clutch has the gear (from the inertia phase until the
                                     * command's withdrawal): the off-going clutch stays open */
     wc_lag_compensation_t offgoing_lag;  /* the off-going clutch's lag compensation */

@@ -90,7 +90,8 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(offgoing_holding_factor), SHIFT_FIELD(offgoing_margin_factor), SHIFT_FIELD(offgoing_lag_compensation_time_s),
     SHIFT_FIELD(flare_kp_Nm_per_rad_s), SHIFT_FIELD(flare_ki_Nm_per_rad), SHIFT_FIELD(handover_slip_rad_s),
     SHIFT_FIELD(engine_increase_max_Nm), SHIFT_FIELD(engine_reduction_max_Nm), SHIFT_FIELD(engine_fill_fraction),
-    SHIFT_FIELD(engine_reduction_fraction), SHIFT_FIELD(engine_recovery_time_s), SHIFT_FIELD(fallback_time_s),
+    SHIFT_FIELD(engine_reduction_fraction), SHIFT_FIELD(engine_recovery_time_s), SHIFT_FIELD(engine_lead_time_s),
+    SHIFT_FIELD(fallback_time_s),
 };
 
 static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)

@@ -5,6 +5,9 @@
 
 #include "wc_field_ranges.h"
 #include "wc_internal.h"
+#ifdef WC_SHIFT_TRACE
+#include <stdio.h>
+#endif
 
 /* A value in [lo, hi] (false for NaN). */
 static bool in_closed(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
@@ -73,8 +76,9 @@ static bool in_closed(float value, float lo, float hi) { return (value >= lo) &&
     X(engine_increase_max_Nm, WC_SHIFT_CAL_ENGINE_INCREASE_MAX, 0u, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm) \
     X(engine_reduction_max_Nm, WC_SHIFT_CAL_ENGINE_REDUCTION_MAX, 0u, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm) \
     X(engine_fill_fraction, WC_SHIFT_CAL_ENGINE_FILL_FRACTION, 0u, 0.0f, 1.0f) \
-    X(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0u, 0.0f, 1.0f) \
+    X(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0u, 0.0f, 2.0f) \
     X(engine_recovery_time_s, WC_SHIFT_CAL_ENGINE_RECOVERY_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s) \
+    X(engine_lead_time_s, WC_SHIFT_CAL_ENGINE_LEAD_TIME, 0u, 0.0f, 1.0f) \
     X(fallback_time_s, WC_SHIFT_CAL_FALLBACK_TIME, 0u, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s)
 
 #define WC_SHIFT_RANGE(member, code, flags, low, high) { (low), (high) },
@@ -201,7 +205,11 @@ static bool coordinated(const wc_shift_calibration_t *cal, const wc_shift_offgoi
 static void start(wc_shift_t *shift, const wc_shift_command_t *command, float slip_rad_s,
                   const wc_lag_compensation_t *lag, const wc_lag_compensation_t *offgoing_lag, wc_adapt_t *adapt)
 {
+    const float last_slip_rad_s = shift->last_slip_rad_s;  /* the slip's rate goes on across the start */
+    const float slip_rate_rad_s2 = shift->slip_rate_rad_s2;
     wc_shift_init(shift);
+    shift->last_slip_rad_s = last_slip_rad_s;
+    shift->slip_rate_rad_s2 = slip_rate_rad_s2;
     wc_adapt_begin(adapt);  /* a new window (NULL: none) */
     shift->lag_compensation = *lag;  /* its exponential once per shift, not per step */
     shift->offgoing_lag = *offgoing_lag;
@@ -223,6 +231,18 @@ static void enter_lockup(wc_shift_t *shift, float elapsed_s)
     enter(shift, WC_SHIFT_LOCKUP);
 }
 
+/* The whole shift's torque phase (DESIGN 14): the on-coming clutch's share
+ * of the turbine torque, a smoothstep over torque_phase_time_s (zero slope at
+ * both ends: the off-going clutch's lagging release is not left behind at the
+ * hand-over, and the output torque does not kink), lead_s ahead. */
+static float torque_phase_share(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, float lead_s)
+{
+    const float t_s = (float)(shift->phase_periods + 1u) * dt_s + lead_s;
+    const float x = (cal->torque_phase_time_s > 0.0f) ? (t_s / cal->torque_phase_time_s) : 1.0f;
+    const float xc = (x < 1.0f) ? x : 1.0f;
+    return xc * xc * (3.0f - 2.0f * xc);
+}
+
 /* The torque request of this period (the phase's law); may change the phase.
  * d: the driveline terms of this step, carried_Nm the feed-forward at a zero
  * slip rate. coord: the whole shift (DESIGN 14). */
@@ -240,7 +260,8 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
          * speeds show the tie-up): the torque phase is over, the off-going clutch is released */
         const bool handed_over = coord && (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s);
         if ((shift->phase_periods < n) && !handed_over) {
-            return share_Nm * (float)(shift->phase_periods + 1u) / (float)n;
+            return share_Nm * (coord ? torque_phase_share(shift, cal, dt_s, 0.0f)
+                                     : ((float)(shift->phase_periods + 1u) / (float)n));
         }
         /* inertia phase: the reference starts at the measured slip; bumpless:
          * the integral takes what the feed-forward does not give of the last request */
@@ -276,6 +297,9 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         if ((slip_rad_s >= shift->start_slip_rad_s) && (shift->request_Nm > cal->tie_up_factor * share_Nm)) {
             shift->report.tie_up = true;  /* the turbine does not move although the clutch pulls hard: something holds it */
         }
+#ifdef WC_SHIFT_TRACE
+        fprintf(stderr, "TRACE k=%u ff=%g err=%g int=%g slip=%g ref=%g start=%g Tt=%g\n", (unsigned)shift->phase_periods, (double)ff_Nm, (double)error, (double)shift->integral_Nm, (double)slip_rad_s, (double)reference, (double)shift->start_slip_rad_s, (double)shift->turbine_torque_Nm);
+#endif
         return ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
     }
     /* DESIGN 14: the hold covers the driver's torque while the engine's reduction ramps out */
@@ -388,10 +412,13 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
 
 /* The engine's torque request of this step (DESIGN 14): torque phase, an
  * increase with the on-coming clutch's ramp that fills part of the torque
- * hole (b1 - b) / b * T_t0; inertia phase, from it to a reduction of the
- * driver's torque with the reference (smoothstep), which cuts the friction
- * energy; after it the reduction ramps out in engine_recovery_time_s. 0 and
- * inactive otherwise, and in a fallback. */
+ * hole (b1 - b) / b * T_t0; inertia phase, the increase fades with the
+ * reference while a reduction of engine_reduction_fraction times the
+ * turbine's inertia torque I_t |dref/dt| / a takes the inertia torque out of
+ * the clutch (1: the output torque does not hump and does not step at
+ * lock-up; more: less friction energy); after the inertia phase what is left
+ * ramps out in engine_recovery_time_s. 0 and inactive otherwise, and in a
+ * fallback. */
 static void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, wc_shift_offgoing_t *og)
 {
     float delta_Nm = 0.0f;
@@ -399,19 +426,19 @@ static void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal,
     const float t0_Nm = shift->driver_torque_Nm;
     const float hole_Nm = cal->engine_fill_fraction * (cal->offgoing_ratio - cal->output_ratio) / cal->output_ratio * t0_Nm;
     const float increase_Nm = (hole_Nm < cal->engine_increase_max_Nm) ? hole_Nm : cal->engine_increase_max_Nm;
-    const float cut_Nm = cal->engine_reduction_fraction * t0_Nm;
-    const float reduction_Nm = (cut_Nm < cal->engine_reduction_max_Nm) ? cut_Nm : cal->engine_reduction_max_Nm;
     const uint32_t phase = shift->phase;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
-        const uint32_t n = periods_of(cal->torque_phase_time_s, dt_s);
-        const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
-        delta_Nm = increase_Nm * ((x < 1.0f) ? x : 1.0f);
+        delta_Nm = increase_Nm * torque_phase_share(shift, cal, dt_s, cal->engine_lead_time_s);
         shift->recovery_periods = 0u;
     } else if (phase == (uint32_t)WC_SHIFT_INERTIA) {
-        const float x = (float)shift->phase_periods * dt_s / shift->target_time_s;  /* target >= 0.05 s (checked) */
-        const float xc = (x < 1.0f) ? x : 1.0f;
-        const float s = xc * xc * (3.0f - 2.0f * xc);  /* the reference's smoothstep (DESIGN 10) */
-        delta_Nm = increase_Nm * (1.0f - s) - reduction_Nm * s;
+        float rate_rad_s2;
+        const float elapsed_s = (float)shift->phase_periods * dt_s + cal->engine_lead_time_s;
+        const float reference = reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float s = (shift->start_slip_rad_s > 0.0f) ? (1.0f - reference / shift->start_slip_rad_s) : 1.0f;
+        const float inertia_Nm = cal->engine_reduction_fraction * cal->turbine_inertia_kg_m2 * fabsf(rate_rad_s2) /
+                                 cal->turbine_ratio;
+        const float reduction_Nm = (inertia_Nm < cal->engine_reduction_max_Nm) ? inertia_Nm : cal->engine_reduction_max_Nm;
+        delta_Nm = increase_Nm * (1.0f - s) - reduction_Nm;
         shift->engine_from_Nm = delta_Nm;
         shift->recovery_periods = 0u;
     } else if ((phase == (uint32_t)WC_SHIFT_LOCKUP) || (phase == (uint32_t)WC_SHIFT_LOCKED)) {
@@ -456,13 +483,20 @@ static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
             in->torque_request_Nm = clamp_torque_Nm(cal->offgoing_holding_factor * t_t_Nm);
             in->carried_torque_Nm = clamp_torque_Nm(t_t_Nm);
         } else if (phase == (uint32_t)WC_SHIFT_TORQUE) {
-            const float carried_Nm = clamp_torque_Nm(t_t_Nm - cal->turbine_ratio * oncoming_torque_Nm);
+            /* in 1st gear the turbine accelerates with the vehicle: dslip/dt = (1 - b / b1) dw_t/dt (a = 1),
+             * and I_t dw_t/dt of the turbine torque goes into that, not through the clutches */
+            const float gear_step = 1.0f - cal->output_ratio / cal->offgoing_ratio;  /* > 0: checked */
+            const float turbine_accel_Nm = cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step;
+            const float carried_Nm = clamp_torque_Nm(t_t_Nm - turbine_accel_Nm - cal->turbine_ratio * oncoming_torque_Nm);
             const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
             const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
             shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
             if (flare_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
             in->mode = WC_MODE_TORQUE;
-            in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm +
+            /* the margin tapers with the on-coming clutch's ramp: at the hand-over the off-going clutch
+             * holds nothing the on-coming one could fight (tie-up) */
+            const float taper = 1.0f - torque_phase_share(shift, cal, dt_s, 0.0f);
+            in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
                                                     cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
             in->carried_torque_Nm = carried_Nm;
         } else {
@@ -582,6 +616,11 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     if (coord) {
         const float s = offgoing->in->slip_rad_s;
         shift->offgoing_slip_rad_s = wc_slip_valid(s) ? s : offgoing->clutch->held.slip_rad_s;
+        /* the slip's rate, first-order filtered (DESIGN 14: the turbine's acceleration in 1st gear) */
+        const float alpha = dt_s / (cal->jerk_filter_time_s + dt_s);
+        const float rate = (slip_rad_s - shift->last_slip_rad_s) / dt_s;
+        shift->slip_rate_rad_s2 += (rate - shift->slip_rate_rad_s2) * alpha;
+        shift->last_slip_rad_s = slip_rad_s;
         if (safe) {
             shift->fallback_periods = (shift->fallback_periods < UINT32_MAX) ? (shift->fallback_periods + 1u) : UINT32_MAX;
         } else if (!wc_shift_phase_running(shift->phase)) {

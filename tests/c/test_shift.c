@@ -88,8 +88,9 @@ static const shift_field_t shift_fields[] = {
     SHIFT_FIELD(engine_increase_max_Nm, WC_SHIFT_CAL_ENGINE_INCREASE_MAX, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm, false),
     SHIFT_FIELD(engine_reduction_max_Nm, WC_SHIFT_CAL_ENGINE_REDUCTION_MAX, 0.0f, WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm, false),
     SHIFT_FIELD(engine_fill_fraction, WC_SHIFT_CAL_ENGINE_FILL_FRACTION, 0.0f, 1.0f, false),
-    SHIFT_FIELD(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0.0f, 1.0f, false),
+    SHIFT_FIELD(engine_reduction_fraction, WC_SHIFT_CAL_ENGINE_REDUCTION_FRACTION, 0.0f, 2.0f, false),
     SHIFT_FIELD(engine_recovery_time_s, WC_SHIFT_CAL_ENGINE_RECOVERY_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
+    SHIFT_FIELD(engine_lead_time_s, WC_SHIFT_CAL_ENGINE_LEAD_TIME, 0.0f, 1.0f, false),
     SHIFT_FIELD(fallback_time_s, WC_SHIFT_CAL_FALLBACK_TIME, 0.0f, WC_SHIFT_LIMIT_TIME_MAX_s, false),
 };
 

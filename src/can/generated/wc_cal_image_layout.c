@@ -99,9 +99,10 @@ WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_reduction_max_Nm) == WC
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_fill_fraction) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_fill_fraction_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_reduction_fraction) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_reduction_fraction_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_recovery_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_recovery_time_s_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_lead_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_LEAD_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_lead_time_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, fallback_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_fallback_time_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == 120u, every_clutch_field_in_the_layout);
-WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == 240u, every_shift_field_in_the_layout);
+WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == 244u, every_shift_field_in_the_layout);
 
 void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
 {
@@ -202,6 +203,7 @@ void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION], set->shift.engine_fill_fraction);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION], set->shift.engine_reduction_fraction);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S], set->shift.engine_recovery_time_s);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_LEAD_TIME_S], set->shift.engine_lead_time_s);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S], set->shift.fallback_time_s);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED], set->shift_enabled ? 1u : 0u);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS], set->loop.sensor_timeout_periods);
@@ -310,6 +312,7 @@ void wc_cal_image_layout_decode(const uint8_t *payload, wc_cal_set_t *set)
     set->shift.engine_fill_fraction = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION]);
     set->shift.engine_reduction_fraction = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION]);
     set->shift.engine_recovery_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S]);
+    set->shift.engine_lead_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_LEAD_TIME_S]);
     set->shift.fallback_time_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S]);
     set->shift_enabled = (wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED]) != 0u);
     set->loop.sensor_timeout_periods = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS]);
@@ -424,6 +427,7 @@ static const field_name_t field_names[] = {
     { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_FILL_FRACTION, 4u, "shift.engine_fill_fraction" },
     { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_REDUCTION_FRACTION, 4u, "shift.engine_reduction_fraction" },
     { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S, 4u, "shift.engine_recovery_time_s" },
+    { WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_LEAD_TIME_S, 4u, "shift.engine_lead_time_s" },
     { WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S, 4u, "shift.fallback_time_s" },
     { WC_CAL_IMAGE_OFFSET_LOOP_SHIFT_ENABLED, 4u, "loop.shift_enabled" },
     { WC_CAL_IMAGE_OFFSET_LOOP_SENSOR_TIMEOUT_PERIODS, 4u, "loop.sensor_timeout_periods" },

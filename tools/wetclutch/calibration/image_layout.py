@@ -230,8 +230,9 @@ _SHIFT = {
     "engine_increase_max_Nm": (0.0, shift_rules.ENGINE_DELTA_MAX_NM, "", "torque phase: engine increase limit"),
     "engine_reduction_max_Nm": (0.0, shift_rules.ENGINE_DELTA_MAX_NM, "", "inertia phase: engine reduction limit"),
     "engine_fill_fraction": (0.0, 1.0, "", "torque phase: fraction of the torque hole filled by the engine"),
-    "engine_reduction_fraction": (0.0, 1.0, "", "inertia phase: reduction / T_t0"),
+    "engine_reduction_fraction": (0.0, 2.0, "", "inertia phase: reduction / the turbine's inertia torque I_t |dref/dt| / a"),
     "engine_recovery_time_s": (0.0, _T, "", "the reduction ramps out in this time after the inertia phase"),
+    "engine_lead_time_s": (0.0, 1.0, "", "the engine request runs this far ahead of the reference (engine lag and delay)"),
     "fallback_time_s": (0.0, _T, "", "lost input in the inertia phase or later: finish on the model this long at most"),
 }
 

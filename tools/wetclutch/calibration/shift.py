@@ -99,8 +99,9 @@ FIELDS: tuple[tuple[str, str, str, object], ...] = (
     ("engine_increase_max", "Nm", "engine_increase_max_Nm", lambda v, c: 0.0 <= v <= ENGINE_DELTA_MAX_NM),
     ("engine_reduction_max", "Nm", "engine_reduction_max_Nm", lambda v, c: 0.0 <= v <= ENGINE_DELTA_MAX_NM),
     ("engine_fill_fraction", "1", "engine_fill_fraction", lambda v, c: 0.0 <= v <= 1.0),
-    ("engine_reduction_fraction", "1", "engine_reduction_fraction", lambda v, c: 0.0 <= v <= 1.0),
+    ("engine_reduction_fraction", "1", "engine_reduction_fraction", lambda v, c: 0.0 <= v <= 2.0),
     ("engine_recovery_time", "s", "engine_recovery_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
+    ("engine_lead_time", "s", "engine_lead_time_s", lambda v, c: 0.0 <= v <= 1.0),
     ("fallback_time", "s", "fallback_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S),
 )
 INTEGER_FIELDS = ("theta_source", "adaptation", "coordinator", "engine_intervention")

@@ -2,6 +2,7 @@
 reference on the TCU's inputs (reference_run), and the case on vcan (run_on_vcan)."""
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import os
@@ -69,17 +70,30 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     are encoded; it may change the signals in place (a DBC choice name such as "SNA" encodes its raw value)."""
     p = params
     full = p.turbine_torque_full * scenario.load
+    # the whole shift (DESIGN 14): the TCU drives the off-going clutch and asks the engine for torque
+    whole = int(getattr(shift_cal, "coordinator", 0)) == 1
+    drive_offgoing = whole and not scenario.scripted_release
+    if scenario.offgoing_friction != 1.0:
+        p = dataclasses.replace(p, offgoing_friction_scale=p.offgoing_friction_scale * scenario.offgoing_friction)
     pl = plant_mod.UpshiftPlant(p, oil_degC=scenario.oil_degC, turbine_torque_Nm=full,
                                 friction_scale=p.friction_scale * scenario.friction_scale, seed=seed,
-                                theta_clutch_degC=theta_clutch_degC)
+                                theta_clutch_degC=theta_clutch_degC,
+                                offgoing_current_mA=p.offgoing_cal.vfs_current_max if drive_offgoing else None,
+                                engine_ignores_request=scenario.engine_ignores, offgoing_slip_sensor=whole)
     dt = pl.dt_s
     n_pre = int(round(p.preroll_time / dt))
     n = n_pre + int(round(p.shift_duration / dt))
     msg_cmd = db.get_message_by_name(canlog.COMMAND)
     msg_est = db.get_message_by_name(canlog.ESTIMATE)
     msg_rep = db.get_message_by_name(canlog.SHIFT_REPORT)
+    msg_off = db.get_message_by_name(canlog.OFFGOING_COMMAND)
+    msg_eng = db.get_message_by_name(canlog.ENGINE_REQUEST)
     rec = {k: np.empty(n) for k in ("t_s", "sensor_slip_rad_s", "current_mA", "pressure_command_Pa",
                                     "theta_estimate_degC", "model_torque_Nm", "locked_tcu")}
+    rec.update({k: np.zeros(n) for k in ("offgoing_current_cmd_mA", "engine_delta_cmd_Nm", "tcu_phase",
+                                         "tcu_fallback")})
+    offgoing_current = p.offgoing_cal.vfs_current_max
+    engine_delta = 0.0
     truth = {}
     frames_out = []
     frames_in = []          # what the TCU received, for the reference (reference/shift.py)
@@ -97,6 +111,10 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
                                           "TargetInertiaTime": round(target_s * 1e3)},
                    canlog.SENSORS: {"SlipSpeed": float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
                                     "OilTemp": float(s["oil_degC"]), "HousingTemp": float(s["housing_degC"])}}
+        if whole:   # before ClutchSensors, which steps the loop
+            sensors = signals.pop(canlog.SENSORS)
+            signals[canlog.OFFGOING_SENSORS] = {"OffgoingSlipSpeed": float(np.clip(s["offgoing_slip_rpm"], -8000.0, 8000.0))}
+            signals[canlog.SENSORS] = sensors
         if inject is not None:
             inject(k, k_i, signals)
         frames = [enc.frame(name, **sig) for name, sig in signals.items()]
@@ -117,9 +135,20 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
             elif fid == msg_rep.frame_id:
                 report = msg_rep.decode(data, decode_choices=False)
                 report["step"] = k
+            elif fid == msg_off.frame_id:
+                o = msg_off.decode(data, decode_choices=False)
+                offgoing_current = float(o["VfsCurrent"])
+                rec["tcu_phase"][k] = float(o["ShiftPhase"])
+                rec["tcu_fallback"][k] = float(o["Fallback"])
+            elif fid == msg_eng.frame_id:
+                e = msg_eng.decode(data, decode_choices=False)
+                engine_delta = float(e["TorqueDelta"]) if int(e["InterventionActive"]) else 0.0
         rec["t_s"][k] = k * dt
         rec["sensor_slip_rad_s"][k] = s["slip_rpm"] * plant_mod.RPM
-        pl.step(current, (k - n_pre) * dt if k >= n_pre else None)
+        rec["offgoing_current_cmd_mA"][k] = offgoing_current
+        rec["engine_delta_cmd_Nm"][k] = engine_delta
+        pl.step(current, (k - n_pre) * dt if k >= n_pre else None,
+                offgoing_current if drive_offgoing else None, engine_delta if whole else None)
         for name, v in pl.truth.items():
             truth.setdefault(name, np.empty(n))[k] = v
     rec.update({f"true_{k}": v for k, v in truth.items()})
@@ -128,7 +157,11 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     rec["report"] = report
     rec["t0_s"] = t0_s           # the TCU's time of step k: t0_s + t_s[k]
     rec["command_step"] = n_pre
+    if whole:   # the coordinator may enter the inertia phase early (the hand-over): the TCU's phase says when
+        entered = np.flatnonzero(rec["tcu_phase"] >= 3)
+        k_i = int(entered[0]) if entered.size else k_i
     rec["inertia_step"] = k_i
+    rec["whole"] = whole
     start = rec["sensor_slip_rad_s"][k_i]
     ref = np.full(n, np.nan)
     ref[k_i:] = [shift_reference.reference_slip(start, target_s, j * dt)[0] for j in range(n - k_i)]
@@ -155,6 +188,7 @@ def record_messages(records: list[dict]) -> list:
 
 BETWEEN_SHIFTS_S = 0.5   # back-to-back shifts: the 2->1 downshift's release between them (see between_shifts)
 IDLE_FRAMES = (canlog.REQUEST, canlog.SHIFT_COMMAND, canlog.SENSORS)
+IDLE_FRAMES_WHOLE = (canlog.REQUEST, canlog.SHIFT_COMMAND, canlog.OFFGOING_SENSORS, canlog.SENSORS)
 
 
 @functools.lru_cache(maxsize=32)
@@ -165,6 +199,7 @@ def _idle_frames(oil_degC: float, housing_degC: float, target_ms: int) -> dict:
     for name, sig in ((canlog.REQUEST, {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT}),
                       (canlog.SHIFT_COMMAND, {"ShiftRequest": 0, "AdaptationReset": 0, "TargetGear": 2,
                                               "TurbineTorque": 0.0, "TargetInertiaTime": target_ms}),
+                      (canlog.OFFGOING_SENSORS, {"OffgoingSlipSpeed": 0.0}),
                       (canlog.SENSORS, {"SlipSpeed": 0.0, "OilTemp": oil_degC, "HousingTemp": housing_degC})):
         msg = db.get_message_by_name(name)
         frames = []
@@ -177,7 +212,8 @@ def _idle_frames(oil_degC: float, housing_degC: float, target_ms: int) -> dict:
 
 
 def between_shifts(params, tcu, enc, oil_degC: float, theta_clutch_degC: float | None, t0_s: float,
-                   gap_s: float = BETWEEN_SHIFTS_S, target_s: float = TARGET_INERTIA_S) -> tuple[float | None, float]:
+                   gap_s: float = BETWEEN_SHIFTS_S, target_s: float = TARGET_INERTIA_S,
+                   whole: bool = False) -> tuple[float | None, float]:
     """The time between two shifts, where a vehicle's 2->1 downshift releases the on-coming clutch: gap_s
     of frames with ShiftRequest 0 and no slip (the released clutch in 2nd gear, before 1st gear's slip
     builds up), so the TCU's VFS and film release the clutch without slip (no model heat); the plant's pack
@@ -195,7 +231,7 @@ def between_shifts(params, tcu, enc, oil_degC: float, theta_clutch_degC: float |
     steps = []
     for _ in range(n):
         batch = []
-        for name in IDLE_FRAMES:
+        for name in (IDLE_FRAMES_WHOLE if whole else IDLE_FRAMES):
             count = enc.counters.get(name, 0)
             batch.append(frames[name][count])
             enc.counters[name] = (count + 1) % 16      # as Encoder.frame counts
@@ -229,7 +265,8 @@ def run_case(params, shift_name: str, scenario: Scenario, overrides: dict | None
         records = []
         for i in range(scenario.shifts):
             if i > 0:
-                theta, t0 = between_shifts(params, tcu, enc, scenario.oil_degC, theta, t0, target_s=target_s)
+                theta, t0 = between_shifts(params, tcu, enc, scenario.oil_degC, theta, t0, target_s=target_s,
+                                           whole=int(getattr(shift_cal, "coordinator", 0)) == 1)
             rec = _one_shift(params, tcu, enc, db, scenario, theta, t0, params.seed + i, target_s, shift_cal)
             records.append(rec)
             theta = rec["end_theta_degC"]

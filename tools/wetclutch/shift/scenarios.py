@@ -32,6 +32,10 @@ class Scenario:
     friction_scale: float = 1.0
     shifts: int = 1              # > 1: back-to-back shifts, temperatures carried over (heat soak)
     group: str = ""
+    # the whole shift (DESIGN 14)
+    engine_ignores: bool = False         # the engine ignores the TCU's torque request
+    offgoing_friction: float = 1.0       # x the plant's off-going friction (a model error of the off-going clutch)
+    scripted_release: bool = False       # the off-going clutch released by the plant's script (issue 13's way)
 
 
 def scenario_matrix(nominal_oil_degC: float = 80.0) -> list[Scenario]:

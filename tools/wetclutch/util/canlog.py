@@ -23,7 +23,9 @@ DBC_PATH = ROOT / "hil" / "wetclutch.dbc"
 SENSORS, REQUEST, COMMAND, ESTIMATE, BENCH = (
     "ClutchSensors", "TorqueRequest", "VfsCommand", "ClutchEstimate", "BenchMeasurement")
 SHIFT_COMMAND, SHIFT_REPORT = "ShiftCommand", "ShiftReport"
-E2E_FRAMES = (SENSORS, REQUEST, SHIFT_COMMAND, COMMAND)
+# the whole shift (DESIGN 14)
+OFFGOING_SENSORS, OFFGOING_COMMAND, ENGINE_REQUEST = "OffgoingSensors", "OffgoingVfsCommand", "EngineTorqueRequest"
+E2E_FRAMES = (SENSORS, REQUEST, SHIFT_COMMAND, COMMAND, OFFGOING_SENSORS, OFFGOING_COMMAND, ENGINE_REQUEST)
 MODE_OPEN, MODE_TORQUE_CONTROL, MODE_LOCKED, MODE_SHIFT = 0, 1, 2, 3
 
 
