@@ -226,6 +226,11 @@ typedef enum {
 #define WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa 1e6f
 /* The hand-over waits this many lockup_ramp_time_s for the lock-up (its dwell, a slow cold film). */
 #define WC_SHIFT_LOCKUP_WAIT 4u
+/* The whole shift (DESIGN 14): into the inertia phase the off-going clutch
+ * goes on tracking what it still carries until its slip shows that the
+ * on-coming clutch holds the turbine (below -handover_slip_rad_s), at most
+ * this long; then it is released. */
+#define WC_SHIFT_HANDOVER_MAX_s 0.1f
 
 wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *cal);
 
@@ -303,6 +308,7 @@ typedef struct {
     float offgoing_slip_rad_s;     /* this step's off-going slip (measured, else the clutch's last valid) */
     float last_slip_rad_s;         /* the on-coming slip of the last step */
     float slip_rate_rad_s2;        /* its rate, filtered (jerk_filter_time_s): in 1st gear the turbine's acceleration */
+    bool offgoing_released;        /* the hand-over is over: the off-going clutch is open (DESIGN 14) */
     bool second_gear;              /* the on-coming clutch has the gear (from the inertia phase until the
                                     * command's withdrawal): the off-going clutch stays open */
     wc_lag_compensation_t offgoing_lag;  /* the off-going clutch's lag compensation */

@@ -231,6 +231,17 @@ static void enter_lockup(wc_shift_t *shift, float elapsed_s)
     enter(shift, WC_SHIFT_LOCKUP);
 }
 
+/* The turbine torque that goes through the clutches in 1st gear (DESIGN 14):
+ * the turbine accelerates with the vehicle, dslip/dt = (1 - b / b1) dw_t/dt
+ * (a = 1), and I_t dw_t/dt of T_t goes into that, not through the clutches.
+ * The on-coming clutch takes over this much (more pulls against the
+ * off-going one: tie-up), and the off-going one carries what is left of it. */
+static float through_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *cal)
+{
+    const float gear_step = 1.0f - cal->output_ratio / cal->offgoing_ratio;  /* > 0: checked with the coordinator */
+    return clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
+}
+
 /* The whole shift's torque phase (DESIGN 14): the on-coming clutch's share
  * of the turbine torque, a smoothstep over torque_phase_time_s (zero slope at
  * both ends: the off-going clutch's lagging release is not left behind at the
@@ -260,8 +271,12 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
          * speeds show the tie-up): the torque phase is over, the off-going clutch is released */
         const bool handed_over = coord && (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s);
         if ((shift->phase_periods < n) && !handed_over) {
-            return share_Nm * (coord ? torque_phase_share(shift, cal, dt_s, 0.0f)
-                                     : ((float)(shift->phase_periods + 1u) / (float)n));
+            if (!coord) { return share_Nm * (float)(shift->phase_periods + 1u) / (float)n; }
+            /* a flare (the off-going clutch slips forward) is also taken by the on-coming clutch, which takes
+             * the torque over anyway and follows faster than the off-going one's falling pressure */
+            const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
+            return share_Nm * torque_phase_share(shift, cal, dt_s, 0.0f) +
+                   cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm;
         }
         /* inertia phase: the reference starts at the measured slip; bumpless:
          * the integral takes what the feed-forward does not give of the last request */
@@ -475,6 +490,7 @@ static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
     in->theta_from_oil = false;
     const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
     in->correction = none;
+    bool handing_over = false;
     if (!shift->second_gear) {
         if (safe || (phase == (uint32_t)WC_SHIFT_ABORTED)) {
             in->mode = WC_MODE_LOCKED;  /* hold the gear without inputs (hand-back) */
@@ -483,11 +499,21 @@ static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
             in->torque_request_Nm = clamp_torque_Nm(cal->offgoing_holding_factor * t_t_Nm);
             in->carried_torque_Nm = clamp_torque_Nm(t_t_Nm);
         } else if (phase == (uint32_t)WC_SHIFT_TORQUE) {
-            /* in 1st gear the turbine accelerates with the vehicle: dslip/dt = (1 - b / b1) dw_t/dt (a = 1),
-             * and I_t dw_t/dt of the turbine torque goes into that, not through the clutches */
-            const float gear_step = 1.0f - cal->output_ratio / cal->offgoing_ratio;  /* > 0: checked */
-            const float turbine_accel_Nm = cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step;
-            const float carried_Nm = clamp_torque_Nm(t_t_Nm - turbine_accel_Nm - cal->turbine_ratio * oncoming_torque_Nm);
+            handing_over = true;
+        } else {
+            /* INERTIA .. LOCKED without second gear: cannot happen (set on entering INERTIA); open */
+        }
+    } else if ((phase == (uint32_t)WC_SHIFT_INERTIA) && !shift->offgoing_released) {
+        /* the hand-over's end: the off-going clutch slips backwards (the on-coming one holds the turbine) */
+        shift->offgoing_released = (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s) ||
+                                   ((float)shift->phase_periods * dt_s >= WC_SHIFT_HANDOVER_MAX_s);
+        handing_over = !shift->offgoing_released;
+    } else {
+        /* second gear: open */
+    }
+    if (handing_over) {
+        {
+            const float carried_Nm = clamp_torque_Nm(through_Nm(shift, cal) - cal->turbine_ratio * oncoming_torque_Nm);
             const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
             const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
             shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
@@ -495,12 +521,10 @@ static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
             in->mode = WC_MODE_TORQUE;
             /* the margin tapers with the on-coming clutch's ramp: at the hand-over the off-going clutch
              * holds nothing the on-coming one could fight (tie-up) */
-            const float taper = 1.0f - torque_phase_share(shift, cal, dt_s, 0.0f);
+            const float taper = (phase == (uint32_t)WC_SHIFT_TORQUE) ? (1.0f - torque_phase_share(shift, cal, dt_s, 0.0f)) : 0.0f;
             in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
                                                     cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
             in->carried_torque_Nm = carried_Nm;
-        } else {
-            /* INERTIA .. LOCKED without second gear: cannot happen (set on entering INERTIA); open */
         }
     }
     (void)wc_clutch_step(og->clutch, in, og->out);
