@@ -58,3 +58,61 @@ def plot_case(path: Path, runs: dict, title: str) -> None:
         plotting.fit_y_to_x(ax)   # the records run from the pre-roll to 1.5 s: fit what the window shows
     fig.suptitle(title)
     plotting.save(fig, path)
+
+
+def plot_whole_case(path: Path, runs: dict, title: str) -> None:
+    """Fig. 4-style panels of a whole shift (DESIGN 14), the controllers overlaid: speeds, slip and reference,
+    both clutches' torques and the engine's, both pistons' pressures, vehicle acceleration and jerk, the
+    on-coming clutch's temperature (true and estimated)."""
+    from ..util import plotting
+    fig, axes = plotting.subplots(3, 2, figsize=(13, 11), sharex=True)
+    colors = {"whole_feedback": "tab:red", "whole_blind": "tab:orange", "whole_full": "tab:blue"}
+    labels = {"whole_feedback": "(a)", "whole_blind": "(b)", "whole_full": "(c)"}
+    for ctrl, rec in runs.items():
+        c = colors.get(ctrl, "k")
+        lab = labels.get(ctrl, ctrl)
+        k0 = rec["command_step"]
+        t = rec["t_s"] - rec["t_s"][k0]
+        full = ctrl == "whole_full"
+        ax = axes[0, 0]
+        ax.plot(t, rec["true_turbine_speed_rpm"], color=c, label=f"turbine {lab}")
+        if full:
+            ax.plot(t, rec["true_gear1_speed_rpm"], "k:", lw=1, label="1st-gear sync (i1 w_o)")
+            ax.plot(t, rec["true_gear2_speed_rpm"], "k--", lw=1, label="2nd-gear sync (i2 w_o)")
+        ax = axes[0, 1]
+        ax.plot(t, rec["true_slip_rad_s"] / plant_mod.RPM, color=c, label=f"on-coming slip {lab}")
+        ax.plot(t, rec["reference_slip_rad_s"] / plant_mod.RPM, color=c, ls="--", lw=1)
+        ax = axes[1, 0]
+        ax.plot(t, rec["true_clutch_torque_Nm"], color=c, label=f"on-coming {lab}")
+        ax.plot(t, rec["true_offgoing_torque_Nm"], color=c, ls="-.", label=f"off-going {lab}")
+        if full:
+            ax.plot(t, rec["true_engine_torque_Nm"], color="tab:green", label="engine (turbine) torque (c)")
+        ax = axes[1, 1]
+        ax.plot(t, rec["true_pressure_Pa"] * 1e-3, color=c, label=f"on-coming piston {lab}")
+        ax.plot(t, rec["true_offgoing_pressure_Pa"] * 1e-3, color=c, ls="-.", label=f"off-going piston {lab}")
+        if full:
+            ax.plot(t, rec["pressure_command_Pa"] * 1e-3, color=c, ls="--", lw=1, label="on-coming wanted (c)")
+        ax = axes[2, 0]
+        dt = rec["t_s"][1] - rec["t_s"][0]
+        acc = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
+        ax.plot(t, acc, color=c, label=f"accel {lab}")
+        ax.plot(t, np.gradient(acc, dt) / 10.0, color=c, ls=":", lw=1)
+        ax = axes[2, 1]
+        ax.plot(t, rec["true_theta_clutch_degC"], color=c, label=f"true {lab}")
+        ax.plot(t, rec["theta_estimate_degC"], color=c, ls="--", lw=1)
+    plotting.style(axes[0, 0], ylabel="speed (rpm)", title="turbine and synchronous speeds", legend={"fontsize": 7})
+    plotting.style(axes[0, 1], ylabel="slip (rpm)", title="on-coming slip (solid) and reference (dashed)",
+                   legend={"fontsize": 7})
+    plotting.style(axes[1, 0], ylabel="torque (Nm)", title="clutch torques (on-coming solid, off-going dash-dot), engine",
+                   legend={"fontsize": 7})
+    plotting.style(axes[1, 1], ylabel="pressure (kPa)", title="piston pressures (on-coming solid, off-going dash-dot)",
+                   legend={"fontsize": 7})
+    plotting.style(axes[2, 0], xlabel="time from shift command (s)", ylabel="m/s^2  |  jerk / 10 (m/s^3)",
+                   title="vehicle acceleration (10 Hz) and jerk/10 (dotted)", legend={"fontsize": 7})
+    plotting.style(axes[2, 1], xlabel="time from shift command (s)", ylabel="degC",
+                   title="on-coming clutch temperature: true (solid), TCU estimate (dashed)", legend={"fontsize": 7})
+    for ax in axes.flat:
+        ax.set_xlim(-0.05, 1.3)
+        plotting.fit_y_to_x(ax)
+    fig.suptitle(title)
+    plotting.save(fig, path)

@@ -16,7 +16,7 @@ from ..reference import shift as shift_reference
 from ..simulate import plant as plant_mod
 from ..util import canlog
 from .quality import quality
-from .scenarios import NOMINAL, ROOT, SHIFT_TOML, TARGET_INERTIA_S, Scenario, ShiftError, scenario_matrix
+from .scenarios import FAULTS, NOMINAL, ROOT, SHIFT_TOML, TARGET_INERTIA_S, Scenario, ShiftError, scenario_matrix
 from .tcu import InprocTcu, VcanTcu
 
 
@@ -62,6 +62,20 @@ def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: s
     return 0
 
 
+def _fault_injector(fault: str, k_torque: int, k_inertia: int, dt: float, then=None):
+    """The injector of scenarios.FAULTS[fault]: SlipSpeed SNA over its window (then: another injector after it)."""
+    phase, offset_s, duration_s = FAULTS[fault]
+    k0 = (k_torque if phase == "torque" else k_inertia) + int(round(offset_s / dt))
+    k1 = k0 + int(round(duration_s / dt))
+
+    def inject(k, k_i, signals):
+        if k0 <= k < k1:
+            signals[canlog.SENSORS]["SlipSpeed"] = "SNA"
+        if then is not None:
+            then(k, k_i, signals)
+    return inject
+
+
 def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s: float, seed: int,
                target_s: float, shift_cal, inject=None) -> dict:
     """One shift on a fresh plant (1st gear, steady): pre-roll, command, shift_duration. Returns the record.
@@ -102,6 +116,8 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
     n_prep = int(shift_cal.prepare_time / dt + 0.5)
     n_tp = int(shift_cal.torque_phase_time / dt + 0.5)
     k_i = n_pre + n_prep + n_tp           # the controller enters the inertia phase at this step (wc_shift.c)
+    if scenario.fault:                    # a lost input in the middle of the shift (scenarios.FAULTS)
+        inject = _fault_injector(scenario.fault, n_pre + n_prep + n_tp // 2, k_i, dt, inject)
     for k in range(n):
         t = t0_s + k * dt
         s = pl.sensors()

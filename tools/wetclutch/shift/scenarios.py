@@ -36,6 +36,18 @@ class Scenario:
     engine_ignores: bool = False         # the engine ignores the TCU's torque request
     offgoing_friction: float = 1.0       # x the plant's off-going friction (a model error of the off-going clutch)
     scripted_release: bool = False       # the off-going clutch released by the plant's script (issue 13's way)
+    fault: str = ""                      # a lost input in the middle of the shift (FAULTS), "" none
+
+
+# Faults in the middle of a whole shift (DESIGN 14): ClutchSensors.SlipSpeed SNA (an implausible frame,
+# dropped: the input goes stale, the loop's sensor timeout and safe state follow) from the phase's nominal
+# start (the command + prepare time, + half the torque phase for "torque") + offset_s, for duration_s.
+# name: (phase, offset_s, duration_s)
+FAULTS = {
+    "torque": ("torque", 0.0, 0.2),          # hand back to the off-going gear
+    "inertia": ("inertia", 0.15, 0.2),       # finish on the model, the input back before the shift's end
+    "inertia_long": ("inertia", 0.15, 2.0),  # longer than fallback_time_s: released at last
+}
 
 
 def scenario_matrix(nominal_oil_degC: float = 80.0) -> list[Scenario]:
