@@ -1,15 +1,20 @@
 #!/usr/bin/env bash
-# Closed-loop 1->2 upshifts (issue 13): the plant simulator against the TCU's
-# frame loop in-process, (a) feedback only, (b) 2-DOF thermal-blind, (c) 2-DOF
-# full model, over the scenario matrix; report in out/shift/ (shift_report.md,
-# metrics.json, Fig. 4-style plots). Exit 1 when a target is missed.
-#   bash scripts/shift.sh [--plant tools/plants/OTHER.toml] [--out DIR]
+# The whole closed-loop 1->2 upshift (issue 22, DESIGN 14): fill, the off-going
+# clutch under the TCU's control, the engine torque intervention and the
+# fallback of a lost input, the plants of the vehicle family
+# (tools/plants/vehicles/) against the TCU's frame loop in-process, (a) feedback
+# only, (b) 2-DOF thermal-blind, (c) 2-DOF full model; report in out/shift/
+# (whole_shift_report.md, metrics.json, Fig. 4-style plots, MDF4). Exit 1 when a
+# target is missed.
+#   bash scripts/shift.sh [--vehicles nominal soft ...] [--out DIR]
+#   bash scripts/shift.sh --oncoming-only [--plant tools/plants/OTHER.toml]   (issue 13's comparison)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
 bash scripts/setup.sh
 .venv/bin/wetclutch lut tools/calibrations/bench_identified.toml --out lut >/dev/null
 .venv/bin/wetclutch lut tools/calibrations/shift_1_2.toml --out lut >/dev/null
+.venv/bin/wetclutch vehicle-cal >/dev/null   # the TCU's driveline model of each vehicle (committed; regenerated identically)
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release >/dev/null
 exec .venv/bin/wetclutch shift "$@"

@@ -261,6 +261,22 @@ def _cmd_shift(args) -> int:
               " -> [variants.feedback] of tools/calibrations/shift_1_2.toml")
         return 0
     out = Path(args.out or "out/shift")
+    if not args.oncoming_only:   # the whole shift (issue 22, DESIGN 14) over the vehicle family
+        from .shift import whole
+        vehicles = tuple(args.vehicles or whole.VEHICLES)
+        unknown = [v for v in vehicles if not whole.plant_path(v).is_file()]
+        if unknown:
+            print(f"wetclutch shift: --vehicles: no plant file for {', '.join(unknown)} in {whole.VEHICLES_DIR}"
+                  f" (known: {', '.join(whole.VEHICLES)})", file=sys.stderr)
+            return 2
+        metrics = whole.report(out, vehicles=vehicles)
+        print((out / "whole_shift_report.md").read_text())
+        print(f"wrote {out}/metrics.json, whole_shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"])
+              + f" and {len(metrics['mdf'])} MDF4 files")
+        if metrics["missed"]:
+            print("wetclutch shift: targets missed: " + ", ".join(metrics["missed"]), file=sys.stderr)
+            return 1
+        return 0
     metrics = shift.report(out, plant_path=args.plant)
     print((out / "shift_report.md").read_text())
     print(f"wrote {out}/metrics.json, shift_report.md, " + ", ".join(Path(p).name for p in metrics["plots"])
@@ -269,6 +285,12 @@ def _cmd_shift(args) -> int:
         print("wetclutch shift: targets missed: " + ", ".join(metrics["missed"]), file=sys.stderr)
         return 1
     return 0
+
+
+def _cmd_vehicle_cal(args) -> int:
+    from .generate import vehicle_cal
+    argv = ([args.plants_dir] if args.plants_dir else []) + (["--out", args.out] if args.out else [])
+    return vehicle_cal.main(argv)
 
 
 def _adaptation_study(args) -> int:
@@ -388,8 +410,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip comparing every TCU step with the double-precision reference")
     q.set_defaults(func=_cmd_replay)
 
-    q = sub.add_parser("shift", help="closed-loop 1->2 upshifts on a plant: (a) feedback, (b) 2-DOF thermal-blind,"
-                       " (c) 2-DOF full model over the scenario matrix (issue 13); exit 1 when a target is missed")
+    q = sub.add_parser("shift", help="closed-loop 1->2 upshifts: the whole shift (off-going clutch, engine"
+                       " intervention, fill; issue 22) on the vehicle family, (a) feedback, (b) 2-DOF thermal-blind,"
+                       " (c) 2-DOF full model; --oncoming-only: issue 13's on-coming clutch alone on one plant;"
+                       " exit 1 when a target is missed")
+    q.add_argument("--oncoming-only", action="store_true",
+                   help="issue 13's comparison: the on-coming clutch alone (scripted off-going release) on --plant")
+    q.add_argument("--vehicles", nargs="+", metavar="NAME",
+                   help="the whole shift on these vehicles of tools/plants/vehicles/ (default all)")
     q.add_argument("--plant", default=str(Path(__file__).resolve().parents[1] / "plants" / "upshift_1_2.toml"),
                    help="plant TOML (default tools/plants/upshift_1_2.toml)")
     q.add_argument("--out", help="output directory (default out/shift; with --adaptation-study out/adaptation_study)")
@@ -406,6 +434,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --adaptation-study: consecutive shifts per variant (default 16; 200 for the settling"
                         " target, about 2 minutes per variant)")
     q.set_defaults(func=_cmd_shift)
+    q = sub.add_parser("vehicle-cal", help="write the TCU's driveline model of each vehicle plant"
+                       " (tools/plants/vehicles/*.toml -> tools/calibrations/vehicles/*.toml, DESIGN 14)")
+    q.add_argument("plants_dir", nargs="?", help="directory of vehicle plant files (default tools/plants/vehicles)")
+    q.add_argument("--out", help="output directory (default tools/calibrations/vehicles)")
+    q.set_defaults(func=_cmd_vehicle_cal)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")
     q.add_argument("--out", default="out/film_study", help="output directory (default out/film_study)")
