@@ -14,8 +14,9 @@
 #    calibration reads 1000, the naive inverse agrees with wc_inverse, every
 #    loop frame was accepted) and their outputs are byte-identical.
 # 3. Prints one table (function | -Os median / worst | -O2 median / worst),
-#    the naive/library ratio of the inverse and the flash of each library (and of
-#    the XCP slave's object in the CAN layer) per
+#    the naive/library ratio of the inverse, the whole shift's state sizes (the
+#    probe's RAM lines, which must agree between the levels) and the flash of
+#    each library (and of the XCP slave's object in the CAN layer) per
 #    level, and writes it to build/arm-bench/report.md.
 # 4. FAILS when a worst case exceeds its ceiling in bench/arm_ceilings.txt, or
 #    when a measured function has no ceiling there (for either level).
@@ -43,8 +44,9 @@ trap 'rm -f "$log"' EXIT
 status=0
 
 declare -A median worst samples
-declare -A flash_text flash_data flash_bss ratio_median ratio_worst force_diff nop empty
+declare -A flash_text flash_data flash_bss ratio_median ratio_worst force_diff nop empty ram
 names=()
+ram_names=()
 
 for level in "${levels[@]}"; do
   build=build/arm-bench-$level
@@ -89,6 +91,11 @@ for level in "${levels[@]}"; do
     samples[$level,$name]=$n
     if [ "$level" = "${levels[0]}" ]; then names+=("$name"); fi
   done <"$out"
+  while read -r tag name bytes; do
+    [ "$tag" = RAM ] || continue
+    ram[$level,$name]=$bytes
+    if [ "$level" = "${levels[0]}" ]; then ram_names+=("$name"); fi
+  done <"$out"
   nop[$level]=$(awk '$1 == "NOP" { print $2 }' "$out")
   empty[$level]=$(awk '$1 == "EMPTY" { print $2 }' "$out")
   ratio_median[$level]=$(awk '$1 == "NAIVE" && $2 == "ratio_solve_median" { print $3 }' "$out")
@@ -114,6 +121,18 @@ for level in "${levels[@]}"; do
     flash_data[$level,$lib]=$d
     flash_bss[$level,$lib]=$b
   done
+done
+
+# The whole shift's state sizes (RAM lines): the layout, the same at both levels.
+if [ -z "${ram[${levels[0]},wc_loop_t]:-}" ]; then
+  echo "bench_arm: FAIL: the probe printed no RAM wc_loop_t line" >&2
+  status=1
+fi
+for name in "${ram_names[@]}"; do
+  if [ "${ram[Os,$name]:-}" != "${ram[O2,$name]:-}" ]; then
+    echo "bench_arm: FAIL: RAM $name differs between -Os (${ram[Os,$name]:-none}) and -O2 (${ram[O2,$name]:-none})" >&2
+    status=1
+  fi
 done
 
 # --- ceilings -----------------------------------------------------------------
@@ -176,6 +195,20 @@ qemu_version=$(qemu-system-arm --version | awk 'NR == 1 { print $4 }')
   echo "|---|---:|---:|---:|"
   for level in "${levels[@]}"; do
     echo "| -$level | ${ratio_median[$level]} | ${ratio_worst[$level]} | ${force_diff[$level]} N |"
+  done
+  echo
+  echo "RAM of the whole shift (DESIGN 14; sizeof on the target, the probe's RAM lines):"
+  echo
+  echo "| state | bytes |"
+  echo "|---|---:|"
+  for name in "${ram_names[@]}"; do
+    case $name in
+      wc_loop_t) label='`wc_loop_t` (one per clutch pair: holds the off-going clutch too)' ;;
+      wc_loop_t.offgoing_parts) label='of which the off-going clutch, its input, output, E2E input and sensors' ;;
+      whole_shift_step_state) label='`wc_shift_step` caller: `wc_shift_t` + two clutches with input and output' ;;
+      *) label="\`$name\`" ;;
+    esac
+    echo "| $label | ${ram[${levels[0]},$name]} |"
   done
   echo
   echo "Flash (arm-none-eabi-size, text / data / bss in bytes):"

@@ -42,6 +42,38 @@
  *                               TorqueRequest, ShiftCommand) queued per period.
  * The shift must complete (LOCKED, one report, no safe step) or RESULT FAIL.
  *
+ * The whole shift (DESIGN 14): wc_shift_1_2_whole_full (coordinator 1: fill
+ * pulse, off-going capacity control, engine torque request), the off-going
+ * clutch a second wc_clutch_t with the same clutch calibration as the
+ * on-coming one, one 1->2 upshift (T_t0 100 Nm, on-coming slip 100 rad/s in
+ * 1st gear, target 0.5 s, oil 80 degC) on the bench's two-clutch plant
+ * (whole_plant_t: output speed held, I_t dw_t/dt = T_t - T_2 - T_1 with both
+ * models' torques, stick-slip on the models' static capacities, the engine
+ * following its request at once). Every step from the command's edge to the
+ * step in which the shift ends is a sample (prepare/fill, torque phase with
+ * the off-going capacity control, inertia phase with the off-going clutch's
+ * hand-over, lock-up), after 40 idle periods with the coordinator holding
+ * 1st gear:
+ *   wc_shift_step:whole         wc_shift_step with the off-going clutch
+ *                               (wc_shift_offgoing_t): both clutch steps and
+ *                               the engine request;
+ *   wc_loop_step:whole_shift    wc_loop_step in Shift mode with
+ *                               config.offgoing (wc_loop_whole_shift): four
+ *                               frames queued per period (ClutchSensors,
+ *                               OffgoingSensors, TorqueRequest Mode 3,
+ *                               ShiftCommand with the engine's turbine torque),
+ *                               four sent (+ OffgoingVfsCommand,
+ *                               EngineTorqueRequest), ShiftReport at the end;
+ *   :whole_film, :whole_shift_film  the same with bench_identified (film on).
+ * Each prints its worst step per part of the shift (WHOLE lines: start,
+ * prepare, torque, inertia, lockup). The shift must complete (LOCKED, one
+ * report, no abort, no fallback, the off-going slip below -handover_slip,
+ * the engine asked for more and for less torque, every frame used, no safe
+ * step) or RESULT FAIL. RAM lines: sizeof(wc_loop_t) (it holds the second
+ * clutch, its input, output, E2E input and sensors whether or not the whole
+ * shift runs), wc_clutch_t, wc_shift_t, the loop's off-going parts, and the
+ * state a caller of wc_shift_step keeps for the whole shift.
+ *
  * The calibration image (DESIGN 13): one wc_cal_image_load of the committed
  * lut/wc_table1_cal_image.h (linked into its own .wc_calibration section,
  * mps2_an386.ld), which must be accepted (image, film layout,
@@ -66,6 +98,8 @@
  *   EMPTY <instructions>        window overhead, subtracted from every figure
  *   NOP <instructions>          1000 nops (must read 1000)
  *   ROW <name> <samples> <median> <worst>
+ *   RAM <name> <bytes>          sizes of the whole shift's state (sizeof on the target)
+ *   WHOLE ...                   the whole shift's rows: worst per part, what the shift did
  *   NAIVE ...                   naive-vs-library force check and ratio
  *   RESULT OK | RESULT FAIL <why>
  * main returns 0 only with RESULT OK (startup.S turns it into QEMU's exit code).
@@ -86,6 +120,7 @@
 #include "wc_arm_io.h"
 #include "wc_arm_naive.h"
 #include "wc_arm_xcp.h"
+#include "wc_shift_1_2_shift.h"    /* lut/: wc_shift_1_2_whole_full, the whole shift's calibration */
 #include "wc_table1_cal_image.h"  /* lut/: table1 + shift_1_2_full, in the .wc_calibration section */
 #include "wc_test_fixtures.h"  /* tests/c: the shift scenario of the C tests */
 
@@ -160,6 +195,10 @@ typedef enum {
     ROW_CRC32_MAX_BLOCK,
     ROW_CAL_IMAGE_DECODE,
     ROW_LOOP_RECALIBRATE,
+    ROW_SHIFT_STEP_WHOLE,
+    ROW_LOOP_STEP_WHOLE,
+    ROW_SHIFT_STEP_WHOLE_FILM,
+    ROW_LOOP_STEP_WHOLE_FILM,
     ROWS
 } row_t;
 
@@ -198,10 +237,16 @@ static const char *const row_name[ROWS] = {
     [ROW_LOOP_STEP_SHIFT] = "wc_loop_step:shift_inertia",
     [ROW_SHIFT_STEP_FILM] = "wc_shift_step:inertia_film",
     [ROW_LOOP_STEP_SHIFT_FILM] = "wc_loop_step:shift_inertia_film",
+    [ROW_SHIFT_STEP_WHOLE] = "wc_shift_step:whole",
+    [ROW_LOOP_STEP_WHOLE] = "wc_loop_step:whole_shift",
+    [ROW_SHIFT_STEP_WHOLE_FILM] = "wc_shift_step:whole_film",
+    [ROW_LOOP_STEP_WHOLE_FILM] = "wc_loop_step:whole_shift_film",
 };
 
-/* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods. */
-#define SHIFT_SAMPLES_MAX 768u
+/* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods; the whole
+ * shift's rows sample every step of the shift: prepare 50 + torque phase 220 + inertia at most 800 +
+ * hand-over at most 200 periods (wc_shift_1_2_whole_full, target 0.5 s). */
+#define SHIFT_SAMPLES_MAX 1536u
 /* expf: two arguments per grid point; the shift rows: one per inertia-phase period */
 /* wc_clutch_step:film_lag: the steps of FILM_LAG_STEPS per grid point */
 #define FILM_LAG_SAMPLES_PER_POINT 6u
@@ -246,6 +291,7 @@ typedef struct {
     wc_shift_t *shift;
     const wc_shift_calibration_t *shift_cal;
     wc_adapt_t *adapt;                       /* the shift rows: NULL (adaptation off) or the adaptive run's */
+    wc_shift_offgoing_t *offgoing;           /* the whole shift's rows: the off-going clutch and the engine */
     wc_shift_command_t shift_command;
     wc_shift_report_t shift_report;
     wc_cal_set_t *cal_set;
@@ -320,6 +366,12 @@ THUNK(thunk_shift_step)
     bench_ctx_t *c = ctx;
     c->shift_ended = wc_shift_step(c->shift, c->shift_cal, &c->shift_command, false, c->clutch, c->adapt, &c->step_in,
                                    &c->step_out, &c->shift_report, NULL);
+}
+THUNK(thunk_whole_shift_step)
+{
+    bench_ctx_t *c = ctx;
+    c->shift_ended = wc_shift_step(c->shift, c->shift_cal, &c->shift_command, false, c->clutch, c->adapt, &c->step_in,
+                                   &c->step_out, &c->shift_report, c->offgoing);
 }
 THUNK(thunk_decode_clutch_sensors)
 {
@@ -788,6 +840,308 @@ static void bench_loop_shift(const wc_calibration_t *cal, row_t row)
 }
 
 /* ------------------------------------------------------------------------ */
+/* The whole shift (DESIGN 14): two clutches and the engine request         */
+
+/* wc_shift_1_2_whole_full (lut/wc_shift_1_2_shift.h): coordinator 1, fill pulse, off-going capacity
+ * control, engine intervention. The off-going clutch is a second wc_clutch_t with the same clutch
+ * calibration as the on-coming one. */
+#define WHOLE_SHIFT_CAL wc_shift_1_2_whole_full
+/* Periods with ShiftRequest 0 before the edge: the coordinator holds 1st gear in IDLE (the off-going
+ * clutch's lock-up dwell is 10 periods). The loop's settle (E2E sync, recovery) is longer. */
+#define WHOLE_IDLE_PERIODS 40u
+#define WHOLE_SLIP_MAX_rad_s 1000.0f
+#define WHOLE_PLANT_TURBINE_INERTIA_kg_m2 0.25f  /* the plant's I_t: the nominal of tools/plants/upshift_1_2.toml */
+
+/* The bench's plant of the whole shift (not the tools' vehicle plant: it only has to drive the phases),
+ * the C tests' reduced plant with the off-going clutch added: the output speed w_o held (a vehicle much
+ * heavier than the turbine, and no road load), so both slips move with the turbine speed w_t (a = 1):
+ *   off-going  s1 = w_t - b1 w_o,   on-coming  s2 = w_t - b w_o = s1 + (b1 - b) w_o,
+ *   I_t dw_t/dt = T_t - T_2 - T_1   (T_2, T_1: the clutch models' signed torques of this step),
+ * explicit Euler at the control period, with (b1 - b) w_o = SHIFT_START_SLIP_rad_s (1st gear: s1 = 0,
+ * s2 = 100 rad/s). A clutch at zero slip sticks while the torque it has to hold (T_t minus the other
+ * clutch's torque) stays within its static capacity (the model's, wc_step_output_t.static_capacity_Nm),
+ * else it slips; a slip that crosses 0 sticks there. The engine follows its request at once:
+ * T_t = T_t0 + delta while InterventionActive, which ShiftCommand.TurbineTorque reports in the next period.
+ * Starts in 1st gear: the off-going clutch stuck, s2 = 100 rad/s, T_t = T_t0 = 100 Nm. */
+typedef struct {
+    float offgoing_slip_rad_s;  /* s1 */
+    bool offgoing_stuck;
+    bool oncoming_stuck;
+    float turbine_torque_Nm;    /* T_t with the engine's intervention */
+    float min_offgoing_slip_rad_s;
+    float max_offgoing_slip_rad_s;
+} whole_plant_t;
+
+static float whole_oncoming_slip(const whole_plant_t *p)
+{
+    return p->oncoming_stuck ? 0.0f : (p->offgoing_slip_rad_s + SHIFT_START_SLIP_rad_s);
+}
+
+static void whole_plant_init(whole_plant_t *p)
+{
+    *p = (whole_plant_t){0.0f, true, false, SHIFT_TURBINE_TORQUE_Nm, 0.0f, 0.0f};
+}
+
+static void whole_plant_advance(whole_plant_t *p, const wc_step_output_t *on, const wc_step_output_t *off,
+                                bool engine_active, float engine_delta_Nm)
+{
+    const float t_t = SHIFT_TURBINE_TORQUE_Nm + (engine_active ? engine_delta_Nm : 0.0f);
+    p->turbine_torque_Nm = (t_t > 0.0f) ? t_t : 0.0f;
+    const float turbine_Nm = p->turbine_torque_Nm;
+    if (p->oncoming_stuck && (fabsf(turbine_Nm - off->model.torque_Nm) <= on->static_capacity_Nm)) { return; }
+    p->oncoming_stuck = false;
+    if (p->offgoing_stuck && (fabsf(turbine_Nm - on->model.torque_Nm) <= off->static_capacity_Nm)) { return; }
+    p->offgoing_stuck = false;
+    const float s1 = p->offgoing_slip_rad_s;
+    const float accel = (turbine_Nm - on->model.torque_Nm - off->model.torque_Nm) / WHOLE_PLANT_TURBINE_INERTIA_kg_m2;
+    float next = s1 + accel * wc_arm_calibration->control_period_s;
+    if ((s1 + SHIFT_START_SLIP_rad_s > 0.0f) && (next + SHIFT_START_SLIP_rad_s <= 0.0f)) {
+        next = -SHIFT_START_SLIP_rad_s;  /* the on-coming plates stick: 2nd gear */
+        p->oncoming_stuck = true;
+    } else if (((s1 > 0.0f) && (next <= 0.0f)) || ((s1 < 0.0f) && (next >= 0.0f))) {
+        next = 0.0f;  /* the off-going plates stick: 1st gear */
+        p->offgoing_stuck = true;
+    }
+    next = fminf(fmaxf(next, -WHOLE_SLIP_MAX_rad_s), WHOLE_SLIP_MAX_rad_s);
+    p->offgoing_slip_rad_s = next;
+    p->min_offgoing_slip_rad_s = fminf(p->min_offgoing_slip_rad_s, next);
+    p->max_offgoing_slip_rad_s = fmaxf(p->max_offgoing_slip_rad_s, next);
+}
+
+/* The worst step of each part of the whole shift: the step of the command's edge (the shift's start: two
+ * lag compensations), then by the phase the step starts in. */
+enum { WHOLE_PART_START = 0, WHOLE_PARTS = 1 + (int)WC_SHIFT_LOCKUP };
+static const char *const whole_part_name[WHOLE_PARTS] = {"start", "prepare", "torque", "inertia", "lockup"};
+typedef struct {
+    uint32_t worst[WHOLE_PARTS];
+    uint32_t engine_steps;      /* steps with the engine intervention active */
+    float engine_min_Nm;
+    float engine_max_Nm;
+} whole_parts_t;
+
+/* Record n into row when the step belongs to the shift: it started in a running phase, or it started the
+ * shift (IDLE before, a running phase after). */
+static void whole_record(row_t row, whole_parts_t *parts, uint32_t phase_before, uint32_t phase_after, uint32_t n)
+{
+    uint32_t part;
+    if (wc_shift_phase_running(phase_before)) {
+        part = phase_before;
+    } else if ((phase_before == (uint32_t)WC_SHIFT_IDLE) && wc_shift_phase_running(phase_after)) {
+        part = WHOLE_PART_START;
+    } else {
+        return;
+    }
+    record(row, n);
+    if (n > parts->worst[part]) { parts->worst[part] = n; }
+}
+
+static void whole_engine(whole_parts_t *parts, bool active, float delta_Nm)
+{
+    if (!active) { return; }
+    parts->engine_steps++;
+    parts->engine_min_Nm = fminf(parts->engine_min_Nm, delta_Nm);
+    parts->engine_max_Nm = fmaxf(parts->engine_max_Nm, delta_Nm);
+}
+
+static void whole_print(const char *what, row_t row, const whole_parts_t *parts, const whole_plant_t *plant,
+                        const wc_shift_report_t *report)
+{
+    wc_arm_puts("WHOLE ");
+    wc_arm_puts(row_name[row]);
+    wc_arm_puts(" (");
+    wc_arm_puts(what);
+    wc_arm_puts(") worst by part:");
+    for (uint32_t i = 0u; i < (uint32_t)WHOLE_PARTS; ++i) {
+        wc_arm_puts(" ");
+        wc_arm_puts(whole_part_name[i]);
+        wc_arm_puts(" ");
+        wc_arm_put_u32(parts->worst[i]);
+    }
+    wc_arm_puts("; inertia phase ");
+    wc_arm_put_u32((uint32_t)lroundf(report->inertia_time_s * 1000.0f));
+    wc_arm_puts(" ms, off-going slip ");
+    wc_arm_put_i32((int32_t)lroundf(plant->min_offgoing_slip_rad_s));
+    wc_arm_puts(" .. ");
+    wc_arm_put_i32((int32_t)lroundf(plant->max_offgoing_slip_rad_s));
+    wc_arm_puts(" rad/s, engine active ");
+    wc_arm_put_u32(parts->engine_steps);
+    wc_arm_puts(" steps, delta ");
+    wc_arm_put_i32((int32_t)lroundf(parts->engine_min_Nm));
+    wc_arm_puts(" .. ");
+    wc_arm_put_i32((int32_t)lroundf(parts->engine_max_Nm));
+    wc_arm_puts(" Nm, flare ");
+    wc_arm_put_u32(report->flare ? 1u : 0u);
+    wc_arm_puts(", tie-up ");
+    wc_arm_put_u32(report->tie_up ? 1u : 0u);
+    wc_arm_puts("\n");
+}
+
+/* What a whole shift must have done: completed (one report, LOCKED, no abort, no fallback), the off-going
+ * clutch handed over (its slip turned negative past the hand-over threshold), the engine asked. */
+static bool whole_ok(uint32_t reports, uint32_t phase, const wc_shift_report_t *report, const whole_plant_t *plant,
+                     const whole_parts_t *parts)
+{
+    return (reports == 1u) && (phase == (uint32_t)WC_SHIFT_LOCKED) && (report->abort_reason == 0u) &&
+           (report->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) &&
+           (plant->min_offgoing_slip_rad_s < -WHOLE_SHIFT_CAL.handover_slip_rad_s) && plant->oncoming_stuck &&
+           (parts->engine_steps > 0u) && (parts->engine_min_Nm < 0.0f) && (parts->engine_max_Nm > 0.0f);
+}
+
+static wc_clutch_t offgoing_clutch;
+
+/* wc_shift_step with the coordinator: both clutches of cal, every step of one 1->2 upshift from the
+ * command's edge to the step in which it ends (prepare/fill, torque phase, inertia phase, hand-over). */
+static void bench_whole_shift_step(const wc_calibration_t *cal, row_t row)
+{
+    if ((wc_shift_calibration_check(&WHOLE_SHIFT_CAL) != WC_SHIFT_CAL_OK) || (WHOLE_SHIFT_CAL.coordinator != 1u) ||
+        (wc_clutch_init(&clutch, cal, SHIFT_OIL_degC) != WC_CAL_OK) ||
+        (wc_clutch_init(&offgoing_clutch, cal, SHIFT_OIL_degC) != WC_CAL_OK)) {
+        fail("whole shift: calibration");
+        return;
+    }
+    wc_shift_init(&shift);
+    static wc_step_input_t offgoing_in;
+    static wc_step_output_t offgoing_out;
+    static const wc_step_output_t no_output;
+    offgoing_out = no_output;
+    wc_shift_offgoing_t offgoing = {&offgoing_clutch, &offgoing_in, &offgoing_out, false, 0.0f};
+    whole_plant_t plant;
+    whole_plant_init(&plant);
+    whole_parts_t parts = {{0u}, 0u, 0.0f, 0.0f};
+    ctx.clutch = &clutch;
+    ctx.shift = &shift;
+    ctx.shift_cal = &WHOLE_SHIFT_CAL;
+    ctx.adapt = NULL;
+    ctx.offgoing = &offgoing;
+    ctx.step_out = no_output;  /* wc_shift_step reads the previous step's status (anti-windup) */
+    uint32_t reports = 0u;
+    for (uint32_t k = 0u; (k < SHIFT_MAX_PERIODS) && (reports == 0u); ++k) {
+        ctx.shift_command = (wc_shift_command_t){k >= WHOLE_IDLE_PERIODS, 2u, plant.turbine_torque_Nm, SHIFT_TARGET_TIME_s};
+        ctx.step_in = (wc_step_input_t){.slip_rad_s = whole_oncoming_slip(&plant), .theta_oil_degC = SHIFT_OIL_degC,
+                                        .theta_housing_degC = SHIFT_OIL_degC};
+        offgoing_in = (wc_step_input_t){.slip_rad_s = plant.offgoing_slip_rad_s, .theta_oil_degC = SHIFT_OIL_degC,
+                                        .theta_housing_degC = SHIFT_OIL_degC};
+        const uint32_t phase_before = shift.phase;
+        const uint32_t n = measure(thunk_whole_shift_step, &ctx);
+        whole_record(row, &parts, phase_before, shift.phase, n);
+        if (ctx.shift_ended) { reports++; }
+        whole_engine(&parts, offgoing.engine_active, offgoing.engine_delta_Nm);
+        whole_plant_advance(&plant, &ctx.step_out, &offgoing_out, offgoing.engine_active, offgoing.engine_delta_Nm);
+    }
+    ctx.offgoing = NULL;
+    whole_print("wc_shift_step", row, &parts, &plant, &ctx.shift_report);
+    if (!whole_ok(reports, shift.phase, &ctx.shift_report, &plant, &parts)) {
+        wc_arm_puts("WHOLE phase ");
+        wc_arm_put_u32(shift.phase);
+        wc_arm_puts(", abort reason ");
+        wc_arm_put_u32(ctx.shift_report.abort_reason);
+        wc_arm_puts(", fallback ");
+        wc_arm_put_u32(ctx.shift_report.fallback);
+        wc_arm_puts("\n");
+        fail("wc_shift_step (whole shift): the shift did not complete with a hand-over and the engine's request");
+    }
+}
+
+/* wc_loop_step in Shift mode with the whole shift (config.offgoing: cal again): ClutchSensors,
+ * OffgoingSensors, TorqueRequest (Mode 3) and ShiftCommand queued each period; every step of the shift
+ * as in bench_whole_shift_step; each step sends OffgoingVfsCommand and EngineTorqueRequest too. */
+static void bench_loop_whole_shift(const wc_calibration_t *cal, row_t row)
+{
+    wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
+    config.shift = &WHOLE_SHIFT_CAL;
+    config.offgoing = cal;
+    if (!wc_loop_whole_shift(&config) || (wc_loop_init(&loop, cal, &config, SHIFT_OIL_degC) != WC_CAL_OK)) {
+        fail("whole shift: wc_loop_init");
+        return;
+    }
+    ctx.loop = &loop;
+    whole_plant_t plant;
+    whole_plant_init(&plant);
+    whole_parts_t parts = {{0u}, 0u, 0.0f, 0.0f};
+    uint32_t reports = 0u;
+    uint32_t safe_in_shift = 0u;
+    uint32_t short_steps = 0u;
+    uint8_t alive = 0u;
+    uint32_t frames_in = 0u;
+    const uint32_t per_step = WC_LOOP_TX_CYCLIC + WC_LOOP_TX_WHOLE_SHIFT;
+    for (uint32_t k = 0u; (k < SHIFT_MAX_PERIODS) && (reports == 0u); ++k) {
+        const bool request = k >= SHIFT_LOOP_SETTLE_PERIODS;
+        wc_can_frame_t frame;
+        const wc_can_offgoing_sensors_phys_t og = {plant.offgoing_slip_rad_s / WC_RAD_S_PER_RPM, alive};
+        if ((wc_test_shift_sensors_frame(&frame, whole_oncoming_slip(&plant), alive) != WC_CAN_OK) ||
+            !wc_loop_receive(&loop, &frame)) {
+            fail("whole shift: sensors frame");
+        }
+        frame = wc_test_can_frame(WC_CAN_OFFGOING_SENSORS_FRAME_ID);
+        if ((wc_can_encode_offgoing_sensors(frame.data, &og, sizeof frame.data) != WC_CAN_OK) ||
+            !wc_loop_receive(&loop, &frame)) {
+            fail("whole shift: off-going sensors frame");
+        }
+        if ((wc_test_shift_request_frame(&frame, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, alive) != WC_CAN_OK) ||
+            !wc_loop_receive(&loop, &frame)) {
+            fail("whole shift: request frame");
+        }
+        if ((wc_test_shift_command_frame(&frame, request, plant.turbine_torque_Nm, SHIFT_TARGET_TIME_s * 1000.0f, alive) !=
+             WC_CAN_OK) || !wc_loop_receive(&loop, &frame)) {
+            fail("whole shift: command frame");
+        }
+        frames_in += 4u;
+        alive = wc_e2e_counter_next(alive);
+        const uint32_t safe_before = loop.counters.safe_steps;
+        const uint32_t phase_before = loop.shift.phase;
+        const uint32_t n = measure(thunk_loop_step, &ctx);
+        whole_record(row, &parts, phase_before, loop.shift.phase, n);
+        if (wc_shift_phase_running(phase_before) && (loop.counters.safe_steps != safe_before)) { safe_in_shift++; }
+        if (ctx.tx_frames < per_step) { short_steps++; }
+        if (ctx.tx_frames > per_step) { reports++; }  /* ShiftReport (no AdaptationReport: adaptation off) */
+        whole_engine(&parts, loop.engine_active, loop.engine_delta_Nm);
+        whole_plant_advance(&plant, &loop.last, &loop.offgoing_last, loop.engine_active, loop.engine_delta_Nm);
+    }
+    /* E2E: SyncCounter frames of each of the four inputs are not used */
+    const uint32_t sync = loop.counters.rejected[WC_REJECT_SYNC];
+    whole_print("wc_loop_step", row, &parts, &plant, &loop.report);
+    if (!whole_ok(reports, loop.shift.phase, &loop.report, &plant, &parts) || (safe_in_shift != 0u) ||
+        (short_steps != 0u) || (loop.counters.frames_used + sync != frames_in)) {
+        wc_arm_puts("WHOLE loop phase ");
+        wc_arm_put_u32(loop.shift.phase);
+        wc_arm_puts(", abort reason ");
+        wc_arm_put_u32(loop.report.abort_reason);
+        wc_arm_puts(", reports ");
+        wc_arm_put_u32(reports);
+        wc_arm_puts(", steps without the whole shift's frames ");
+        wc_arm_put_u32(short_steps);
+        wc_arm_puts(", frames used ");
+        wc_arm_put_u32(loop.counters.frames_used);
+        wc_arm_puts(" + sync ");
+        wc_arm_put_u32(sync);
+        wc_arm_puts(" of ");
+        wc_arm_put_u32(frames_in);
+        wc_arm_puts("\n");
+        fail("wc_loop_step (whole shift): the shift did not complete, or a frame was rejected");
+    }
+}
+
+/* RAM of the whole shift (DESIGN 14): the loop's state holds the second clutch whether or not it is used. */
+static void whole_ram(void)
+{
+    const uint32_t offgoing_bytes = (uint32_t)(sizeof loop.offgoing + sizeof loop.offgoing_input +
+                                               sizeof loop.offgoing_last + sizeof loop.offgoing_in +
+                                               sizeof loop.offgoing_sensors);
+    wc_arm_puts("RAM wc_loop_t ");
+    wc_arm_put_u32((uint32_t)sizeof(wc_loop_t));
+    wc_arm_puts("\nRAM wc_clutch_t ");
+    wc_arm_put_u32((uint32_t)sizeof(wc_clutch_t));
+    wc_arm_puts("\nRAM wc_shift_t ");
+    wc_arm_put_u32((uint32_t)sizeof(wc_shift_t));
+    wc_arm_puts("\nRAM wc_loop_t.offgoing_parts ");
+    wc_arm_put_u32(offgoing_bytes);
+    wc_arm_puts("\nRAM whole_shift_step_state ");  /* a caller of wc_shift_step: shift, two clutches, in/out each */
+    wc_arm_put_u32((uint32_t)(sizeof(wc_shift_t) + 2u * (sizeof(wc_clutch_t) + sizeof(wc_step_input_t) +
+                                                         sizeof(wc_step_output_t))));
+    wc_arm_puts("\n");
+}
+
+/* ------------------------------------------------------------------------ */
 /* The XCP slave (wc_xcp.h) in a calibration session                        */
 
 /* The loop runs on the committed image (table1 + shift_1_2_full) in torque
@@ -1040,6 +1394,11 @@ int main(void)
         bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_FILM, false, ROW_SHIFT_STEP_FILM);
         bench_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_ADAPT, true, ROW_SHIFT_END_ADAPT);
         bench_loop_shift(wc_arm_identified_calibration, ROW_LOOP_STEP_SHIFT_FILM);
+        bench_whole_shift_step(wc_arm_calibration, ROW_SHIFT_STEP_WHOLE);
+        bench_loop_whole_shift(wc_arm_calibration, ROW_LOOP_STEP_WHOLE);
+        bench_whole_shift_step(wc_arm_identified_calibration, ROW_SHIFT_STEP_WHOLE_FILM);
+        bench_loop_whole_shift(wc_arm_identified_calibration, ROW_LOOP_STEP_WHOLE_FILM);
+        whole_ram();
         bench_xcp();
 
         wc_arm_puts("GRID ");
