@@ -53,11 +53,11 @@ def tcu() -> Path:
 # (LONGEST_FIRST, as measured on a 2-core machine), so the other worker's work ends with the guest's.
 SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner", "test_xcp_session",
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc", "test_adaptation_study",
-                "test_adaptation_reference"}
+                "test_adaptation_reference", "test_whole_shift"}
 VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_xcp_session"}
-VCAN_TESTS = {"test_vcan_shift_equals_in_process"}
-LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_adaptation_study",
+VCAN_TESTS = {"test_vcan_whole_shift_equals_in_process"}
+LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_whole_shift", "test_adaptation_study",
                  "test_adaptation_reference",
                  "test_cli_output_faults", "test_replay_inproc", "test_lut", "test_cli_bad_input", "test_bench")
 

@@ -1,6 +1,7 @@
 """Closed-loop 1->2 upshifts (issue 13): the shift calibration, the comparison of the three controllers on
-the plant (in-process, the full scenario matrix), determinism, and one shift on vcan against the same
-case in-process (identical frames)."""
+the plant (in-process, the full scenario matrix: `wetclutch shift --oncoming-only`), determinism. The vcan
+against in-process test runs the whole shift (test_whole_shift.py), which takes the same frame loop's path
+and the coordinator's."""
 from __future__ import annotations
 
 import json
@@ -11,7 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vcan_support import needs_vcan
 from wetclutch import calibration, shift
 from wetclutch.simulate import plant
 from wetclutch.calibration import shift as shift_calibration
@@ -94,7 +94,7 @@ def test_firmware_shift_matches_the_double_reference(variant, scenario):
 def matrix(tmp_path_factory):
     """The README's shift command: the full matrix in-process (about a minute)."""
     out = tmp_path_factory.mktemp("shift")
-    result = subprocess.run([sys.executable, "-m", "wetclutch.cli", "shift", "--out", str(out)], cwd=ROOT,
+    result = subprocess.run([sys.executable, "-m", "wetclutch.cli", "shift", "--oncoming-only", "--out", str(out)], cwd=ROOT,
                             capture_output=True, text=True)
     metrics = json.loads((out / "metrics.json").read_text())
     return out, result, metrics
@@ -168,17 +168,3 @@ def test_full_model_never_aborts(matrix):
     full = matrix[2]["cases"]["full"]
     assert {sc: q["abort_reason"] for sc, q in full.items() if q["abort"] != 0} == {}
     assert all(q["abort"] == 0 for q in full["soak"]["per_shift"])
-
-
-@needs_vcan
-def test_vcan_shift_equals_in_process(tmp_path):
-    """One closed-loop shift against wc_tcu on vcan (natively or in the QEMU guest) gives exactly the frames of
-    the same case with the frame loop in-process."""
-    path = shift.run_on_vcan(tmp_path)
-    vcan = json.loads(path.read_text())
-    params = plant.load_plant(plant.DEFAULT_PLANT)
-    nominal = next(s for s in shift.scenario_matrix() if s.name == shift.NOMINAL)
-    inproc = [list(f) for f in shift.frame_sequence(shift.run_case(params, "shift_1_2_full", nominal))]
-    assert len(vcan["frames"]) == len(inproc) > 3000
-    assert vcan["frames"] == inproc
-    assert vcan["quality"][0]["abort"] == 0

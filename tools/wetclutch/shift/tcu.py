@@ -6,7 +6,7 @@ import subprocess
 from pathlib import Path
 
 from ..util import canlog
-from .scenarios import ROOT, TCU_CALIBRATION, WC_REPLAY, ShiftError
+from .scenarios import ROOT, SHIFT_TOML, TCU_CALIBRATION, WC_REPLAY, ShiftError
 
 
 class InprocTcu:
@@ -86,8 +86,9 @@ class InprocTcu:
 
 class VcanTcu:
     """The TCU program on a SocketCAN interface: wc_tcu --clock frame --shift NAME, frames through python-can.
-    Each exchange sends the period's frames and returns what the TCU sent up to its ClutchEstimate (a
-    ShiftReport, sent after it, comes with the next exchange: the frame sequence is the same as in-process)."""
+    Each exchange sends the period's frames and returns what the TCU sent up to its ClutchEstimate (with the
+    whole shift: up to its EngineTorqueRequest); a ShiftReport, sent after them, comes with the next exchange:
+    the frame sequence is the same as in-process."""
 
     def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
                  calibration: str = TCU_CALIBRATION, iface: str = "vcan0", log_dir: Path | None = None):
@@ -98,8 +99,14 @@ class VcanTcu:
         if not program.is_file():
             raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
         db = canlog.database()
-        self.ids = {db.get_message_by_name(n).frame_id for n in (canlog.COMMAND, canlog.ESTIMATE, canlog.SHIFT_REPORT)}
-        self.estimate_id = db.get_message_by_name(canlog.ESTIMATE).frame_id
+        # the whole shift (DESIGN 14): OffgoingVfsCommand and EngineTorqueRequest close each step's cyclic frames
+        from ..calibration import shift as shift_calibration
+        variant = shift_calibration.load(SHIFT_TOML).variants.get(shift_name.split("shift_1_2_")[-1])
+        whole = variant is not None and int(variant.coordinator) == 1
+        names = (canlog.COMMAND, canlog.ESTIMATE, canlog.SHIFT_REPORT) + (
+            (canlog.OFFGOING_COMMAND, canlog.ENGINE_REQUEST) if whole else ())
+        self.ids = {db.get_message_by_name(n).frame_id for n in names}
+        self.estimate_id = db.get_message_by_name(canlog.ENGINE_REQUEST if whole else canlog.ESTIMATE).frame_id
         self.bus = can.Bus(interface="socketcan", channel=iface,
                            can_filters=[{"can_id": i, "can_mask": 0x7FF, "extended": False} for i in sorted(self.ids)])
         self.log = Path(log_dir or ".") / "wc_tcu_shift.txt"
