@@ -1094,8 +1094,8 @@ static void bench_loop_whole_shift(const wc_calibration_t *cal, row_t row)
         if (wc_shift_phase_running(phase_before) && (loop.counters.safe_steps != safe_before)) { safe_in_shift++; }
         if (ctx.tx_frames < per_step) { short_steps++; }
         if (ctx.tx_frames > per_step) { reports++; }  /* ShiftReport (no AdaptationReport: adaptation off) */
-        whole_engine(&parts, loop.engine_active, loop.engine_delta_Nm);
-        whole_plant_advance(&plant, &loop.last, &loop.offgoing_last, loop.engine_active, loop.engine_delta_Nm);
+        whole_engine(&parts, loop.whole.engine_active, loop.whole.engine_delta_Nm);
+        whole_plant_advance(&plant, &loop.last, &loop.offgoing_last, loop.whole.engine_active, loop.whole.engine_delta_Nm);
     }
     /* E2E: SyncCounter frames of each of the four inputs are not used */
     const uint32_t sync = loop.counters.rejected[WC_REJECT_SYNC];

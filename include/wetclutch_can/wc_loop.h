@@ -168,8 +168,8 @@ typedef struct {
     wc_clutch_t offgoing;                   /* the off-going clutch */
     wc_step_input_t offgoing_input;
     wc_step_output_t offgoing_last;
-    bool engine_active;                     /* the engine request of the last step */
-    float engine_delta_Nm;
+    wc_shift_offgoing_t whole;              /* the shift controller's view of them (pointers into this loop) and
+                                             * the engine request of the last step */
     uint8_t tx_alive_offgoing;
     uint8_t tx_alive_engine;
 } wc_loop_t;

@@ -46,6 +46,9 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
         const wc_cal_error_t offgoing_error = wc_clutch_init(&loop->offgoing, config->offgoing, theta_start_degC);
         if (offgoing_error != WC_CAL_OK) { return offgoing_error; }
     }
+    loop->whole.clutch = &loop->offgoing;  /* the shift controller's view of the off-going clutch */
+    loop->whole.in = &loop->offgoing_input;
+    loop->whole.out = &loop->offgoing_last;
     wc_shift_init(&loop->shift);
     wc_adapt_reset(&loop->adapt);
     loop->adapt.status = WC_ADAPT_STATUS_IMAGE_MISSING;  /* until wc_loop_load_adaptation */
@@ -362,8 +365,8 @@ static WC_NOINLINE uint32_t encode_whole_shift(wc_loop_t *loop, wc_can_frame_t o
     out[n].flags = 0u;
     (void)wc_can_encode_offgoing_vfs_command(out[n].data, &command, sizeof out[n].data);
     const wc_can_engine_torque_request_phys_t engine = {
-        .intervention_active = loop->engine_active ? 1.0f : 0.0f,
-        .torque_delta_Nm = loop->engine_active ? loop->engine_delta_Nm : 0.0f,
+        .intervention_active = loop->whole.engine_active ? 1.0f : 0.0f,
+        .torque_delta_Nm = loop->whole.engine_active ? loop->whole.engine_delta_Nm : 0.0f,
         .alive_counter = loop->tx_alive_engine,
     };
     loop->tx_alive_engine = wc_e2e_counter_next(loop->tx_alive_engine);
@@ -496,7 +499,7 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
 }
 
 /* After the model: the model's status bits, the output frames, the counters. */
-static uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
+static WC_NOINLINE uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
     encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
@@ -524,13 +527,10 @@ static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bo
     WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
     uint32_t step = prepare(loop);
     if ((step & STEP_SHIFT) != 0u) {
-        wc_shift_offgoing_t offgoing = { &loop->offgoing, &loop->offgoing_input, &loop->offgoing_last, false, 0.0f };
-        const bool whole = wc_loop_whole_shift(&loop->config);
+        /* the whole shift: loop->whole points at the off-going clutch (wc_loop_init); no copy on the stack */
         const bool ended = wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u,
                                          &loop->clutch, &loop->adapt, &loop->input, &loop->last, &loop->report,
-                                         whole ? &offgoing : NULL);
-        loop->engine_active = offgoing.engine_active;
-        loop->engine_delta_Nm = offgoing.engine_delta_Nm;
+                                         wc_loop_whole_shift(&loop->config) ? &loop->whole : NULL);
         if (ended) {
             step |= STEP_REPORT;
             /* adaptation on: what the shift changed goes out with the report (the hook persists it) */
@@ -540,8 +540,8 @@ static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bo
         (void)wc_clutch_step(&loop->clutch, &loop->input, &loop->last);  /* its status is loop->last.status */
         if (wc_loop_whole_shift(&loop->config)) {  /* not in Shift mode: the off-going clutch is not ours: open */
             (void)wc_clutch_step(&loop->offgoing, &loop->offgoing_input, &loop->offgoing_last);
-            loop->engine_active = false;
-            loop->engine_delta_Nm = 0.0f;
+            loop->whole.engine_active = false;
+            loop->whole.engine_delta_Nm = 0.0f;
         }
     }
     return finish(loop, step, out);

@@ -434,7 +434,7 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
  * lock-up; more: less friction energy); after the inertia phase what is left
  * ramps out in engine_recovery_time_s. 0 and inactive otherwise, and in a
  * fallback. */
-static void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, wc_shift_offgoing_t *og)
+static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, wc_shift_offgoing_t *og)
 {
     float delta_Nm = 0.0f;
     bool active = (cal->engine_intervention == 1u) && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
@@ -470,14 +470,14 @@ static void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal,
     og->engine_delta_Nm = shift->engine_delta_Nm;
 }
 
-/* The off-going clutch's input and step (DESIGN 14): it holds 1st gear at
+/* The off-going clutch's input (DESIGN 14; wc_shift_step steps it): it holds 1st gear at
  * offgoing_holding_factor * T_t until the torque phase; there its request is
  * the torque it still carries, T_t - a T_c (T_c the on-coming model's torque
  * of this step), plus offgoing_margin_factor * T_t0 and the flare correction
  * (PI on the off-going slip above 0: the turbine runs up); released from the
  * inertia phase on (second gear). A hand-back (an abort before the inertia
  * phase) and IDLE in the safe state hold it at the maximum current. */
-static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, bool safe, float oncoming_torque_Nm,
+static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibration_t *cal, bool safe, float oncoming_torque_Nm,
                           float dt_s, wc_shift_offgoing_t *og)
 {
     wc_step_input_t *in = og->in;
@@ -527,7 +527,6 @@ static void offgoing_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
             in->carried_torque_Nm = carried_Nm;
         }
     }
-    (void)wc_clutch_step(og->clutch, in, og->out);
 }
 
 /* After the clutch step: the lock-up decides the inertia phase's end, the
@@ -605,7 +604,7 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
  * the VFS gets fill_pulse_current_mA to stroke the piston fast; the model
  * steps at the kiss point meanwhile (request 0), which is what the chamber
  * holds while the piston strokes against its spring. */
-static void fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
+static WC_NOINLINE void fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
                        float dt_s, wc_step_output_t *out)
 {
     const wc_calibration_t *c = clutch->model.cal;
@@ -653,9 +652,10 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     }
     shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
     (void)wc_clutch_step(clutch, in, out);
-    if (coord) {
+    if (coord) {  /* DESIGN 14: the fill pulse, the off-going clutch (one clutch step deep), the engine */
         fill_pulse(shift, cal, clutch, dt_s, out);
-        offgoing_step(shift, cal, safe, out->model.torque_Nm, dt_s, offgoing);
+        offgoing_input(shift, cal, safe, out->model.torque_Nm, dt_s, offgoing);
+        (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
         engine_request(shift, cal, dt_s, offgoing);
     }
     const bool ended = shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
