@@ -35,29 +35,14 @@ def plot_case(path: Path, runs: dict, title: str) -> None:
         ax = axes[1, 1]
         ax.plot(t, rec["pressure_command_Pa"] * 1e-3, color=c, ls="--", lw=1)
         ax.plot(t, rec["true_pressure_Pa"] * 1e-3, color=c, label=f"piston {lab}")
-        ax = axes[2, 0]
-        dt = rec["t_s"][1] - rec["t_s"][0]
-        acc = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
-        ax.plot(t, acc, color=c, label=f"accel {lab}")
-        ax.plot(t, np.gradient(acc, dt) / 10.0, color=c, ls=":", lw=1)
-        ax = axes[2, 1]
-        ax.plot(t, rec["true_theta_clutch_degC"], color=c, label=f"true {lab}")
-        ax.plot(t, rec["theta_estimate_degC"], color=c, ls="--", lw=1)
+        _accel_and_temperature(axes, t, rec, c, lab)
     plotting.style(axes[0, 0], ylabel="speed (rpm)", title="turbine and synchronous speeds", legend={"fontsize": 7})
     plotting.style(axes[0, 1], ylabel="slip (rpm)", title="slip (solid) and reference (dashed)", legend={"fontsize": 7})
     plotting.style(axes[1, 0], ylabel="torque (Nm)", title="on-coming clutch torque: true (solid), TCU model (dotted)",
                    legend={"fontsize": 7})
     plotting.style(axes[1, 1], ylabel="pressure (kPa)", title="piston pressure (solid) and TCU's wanted pressure (dashed)",
                    legend={"fontsize": 7})
-    plotting.style(axes[2, 0], xlabel="time from shift command (s)", ylabel="m/s^2  |  jerk / 10 (m/s^3)",
-                   title="vehicle acceleration (10 Hz) and jerk/10 (dotted)", legend={"fontsize": 7})
-    plotting.style(axes[2, 1], xlabel="time from shift command (s)", ylabel="degC",
-                   title="clutch temperature: true (solid), TCU estimate (dashed)", legend={"fontsize": 7})
-    for ax in axes.flat:
-        ax.set_xlim(-0.05, 1.0)
-        plotting.fit_y_to_x(ax)   # the records run from the pre-roll to 1.5 s: fit what the window shows
-    fig.suptitle(title)
-    plotting.save(fig, path)
+    _finish(fig, axes, "clutch temperature: true (solid), TCU estimate (dashed)", 1.0, title, path)
 
 
 def plot_whole_case(path: Path, runs: dict, title: str) -> None:
@@ -92,14 +77,7 @@ def plot_whole_case(path: Path, runs: dict, title: str) -> None:
         ax.plot(t, rec["true_offgoing_pressure_Pa"] * 1e-3, color=c, ls="-.", label=f"off-going piston {lab}")
         if full:
             ax.plot(t, rec["pressure_command_Pa"] * 1e-3, color=c, ls="--", lw=1, label="on-coming wanted (c)")
-        ax = axes[2, 0]
-        dt = rec["t_s"][1] - rec["t_s"][0]
-        acc = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
-        ax.plot(t, acc, color=c, label=f"accel {lab}")
-        ax.plot(t, np.gradient(acc, dt) / 10.0, color=c, ls=":", lw=1)
-        ax = axes[2, 1]
-        ax.plot(t, rec["true_theta_clutch_degC"], color=c, label=f"true {lab}")
-        ax.plot(t, rec["theta_estimate_degC"], color=c, ls="--", lw=1)
+        _accel_and_temperature(axes, t, rec, c, lab)
     plotting.style(axes[0, 0], ylabel="speed (rpm)", title="turbine and synchronous speeds", legend={"fontsize": 7})
     plotting.style(axes[0, 1], ylabel="slip (rpm)", title="on-coming slip (solid) and reference (dashed)",
                    legend={"fontsize": 7})
@@ -107,12 +85,30 @@ def plot_whole_case(path: Path, runs: dict, title: str) -> None:
                    legend={"fontsize": 7})
     plotting.style(axes[1, 1], ylabel="pressure (kPa)", title="piston pressures (on-coming solid, off-going dash-dot)",
                    legend={"fontsize": 7})
+    _finish(fig, axes, "on-coming clutch temperature: true (solid), TCU estimate (dashed)", 1.3, title, path)
+
+
+def _accel_and_temperature(axes, t, rec, c, lab) -> None:
+    """The bottom panels of both figures: vehicle acceleration (10 Hz) and jerk / 10, clutch temperature."""
+    ax = axes[2, 0]
+    dt = rec["t_s"][1] - rec["t_s"][0]
+    acc = _lowpass_zero_phase(rec["true_vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ)
+    ax.plot(t, acc, color=c, label=f"accel {lab}")
+    ax.plot(t, np.gradient(acc, dt) / 10.0, color=c, ls=":", lw=1)
+    ax = axes[2, 1]
+    ax.plot(t, rec["true_theta_clutch_degC"], color=c, label=f"true {lab}")
+    ax.plot(t, rec["theta_estimate_degC"], color=c, ls="--", lw=1)
+
+
+def _finish(fig, axes, temperature_title: str, x_max_s: float, title: str, path: Path) -> None:
+    """The bottom panels' style, the time window (the records run from the pre-roll on: fit what it shows), save."""
+    from ..util import plotting
     plotting.style(axes[2, 0], xlabel="time from shift command (s)", ylabel="m/s^2  |  jerk / 10 (m/s^3)",
                    title="vehicle acceleration (10 Hz) and jerk/10 (dotted)", legend={"fontsize": 7})
-    plotting.style(axes[2, 1], xlabel="time from shift command (s)", ylabel="degC",
-                   title="on-coming clutch temperature: true (solid), TCU estimate (dashed)", legend={"fontsize": 7})
+    plotting.style(axes[2, 1], xlabel="time from shift command (s)", ylabel="degC", title=temperature_title,
+                   legend={"fontsize": 7})
     for ax in axes.flat:
-        ax.set_xlim(-0.05, 1.3)
+        ax.set_xlim(-0.05, x_max_s)
         plotting.fit_y_to_x(ax)
     fig.suptitle(title)
     plotting.save(fig, path)

@@ -40,6 +40,7 @@ from ..calibration import shift as shift_calibration
 from ..simulate import plant as plant_mod
 from ..util import mdf
 from ..util.atomic import Staged
+from .comparison import _fmt
 from .plots import plot_whole_case
 from .quality import quality, worst
 from .runner import record_messages, run_case
@@ -197,14 +198,6 @@ def targets(cases: dict) -> dict:
     if faults:
         tg["faults"] = {"met": all(f["ok"] for f in faults.values()), "rows": faults}
     return tg
-
-
-def _fmt(x, nd=1):
-    if isinstance(x, bool):
-        return "yes" if x else "no"
-    if isinstance(x, (int, np.integer)):
-        return str(x)
-    return "n/a" if not math.isfinite(x) else f"{x:.{nd}f}"
 
 
 def markdown(cases: dict, tg: dict) -> str:
