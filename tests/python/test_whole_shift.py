@@ -180,3 +180,11 @@ def test_vcan_whole_shift_equals_in_process(tmp_path):
     assert len(vcan["frames"]) == len(inproc) > 6000
     assert vcan["frames"] == inproc
     assert vcan["quality"][0]["abort"] == 0
+
+
+def test_unknown_vehicle_is_one_line_and_exit_2(tmp_path):
+    res = subprocess.run([sys.executable, "-m", "wetclutch.cli", "shift", "--vehicles", "nominal", "nope",
+                          "--out", str(tmp_path / "o")], cwd=ROOT, capture_output=True, text=True)
+    assert res.returncode == 2
+    assert res.stderr.count("\n") == 1 and "nope" in res.stderr and "Traceback" not in res.stderr
+    assert not (tmp_path / "o").exists()
