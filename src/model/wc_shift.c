@@ -2,12 +2,10 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "wc_field_ranges.h"
 #include "wc_internal.h"
-#ifdef WC_SHIFT_TRACE
-#include <stdio.h>
-#endif
 
 /* A value in [lo, hi] (false for NaN). */
 static bool in_closed(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
@@ -111,8 +109,7 @@ void wc_shift_init(wc_shift_t *shift)
 {
     WC_ASSERT(shift != NULL);
     if (shift == NULL) { return; }
-    static const wc_shift_t idle;  /* all zero: IDLE, no report, no fallback */
-    *shift = idle;
+    (void)memset(shift, 0, sizeof *shift);  /* all zero: IDLE, no report, no fallback (IEEE 754 zeros) */
 }
 
 /* Inline in the step at -O2 (no call, no rate through memory); the public function is the same code. */
@@ -312,9 +309,6 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         if ((slip_rad_s >= shift->start_slip_rad_s) && (shift->request_Nm > cal->tie_up_factor * share_Nm)) {
             shift->report.tie_up = true;  /* the turbine does not move although the clutch pulls hard: something holds it */
         }
-#ifdef WC_SHIFT_TRACE
-        fprintf(stderr, "TRACE k=%u ff=%g err=%g int=%g slip=%g ref=%g start=%g Tt=%g\n", (unsigned)shift->phase_periods, (double)ff_Nm, (double)error, (double)shift->integral_Nm, (double)slip_rad_s, (double)reference, (double)shift->start_slip_rad_s, (double)shift->turbine_torque_Nm);
-#endif
         return ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
     }
     /* DESIGN 14: the hold covers the driver's torque while the engine's reduction ramps out */
