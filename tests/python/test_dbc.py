@@ -39,6 +39,10 @@ FRAMES = {
     "ShiftReport": (0x122, "TCU", {"VCU"}, None, False),   # sent once per shift, not cyclic
     "AdaptationReport": (0x123, "TCU", {"VCU"}, None, False),   # with ShiftReport when adaptation is on (DESIGN 12)
     "BenchMeasurement": (0x130, "BENCH", {"TCU"}, 1, False),
+    # the whole shift (DESIGN 14)
+    "OffgoingSensors": (0x113, "BENCH", {"TCU"}, 1, True),
+    "OffgoingVfsCommand": (0x124, "TCU", {"BENCH"}, 1, True),
+    "EngineTorqueRequest": (0x125, "TCU", {"ECU"}, 1, True),
     # XCP on CAN (DESIGN 13): event-driven command/response, not E2E, the lowest priority on the bus
     "XcpCommand": (0x7F0, "TOOL", {"TCU"}, None, False),
     "XcpResponse": (0x7F1, "TCU", {"TOOL"}, None, False),
@@ -55,7 +59,8 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
     "StatusFrameLost", "StatusBusError", "StatusLocked",
 ]
 # Integer signals that the scaling wrapper does not convert.
-UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", "XcpCommandPid", "XcpResponsePid", *STATUS_BITS}
+UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", "Fallback", "XcpCommandPid", "XcpResponsePid",
+            *STATUS_BITS}
 
 
 def e2e_protect(frame_id: int, data: bytes) -> bytes:
@@ -79,7 +84,7 @@ def db():
 
 def test_loads_strictly_without_warnings(db):
     assert {m.name for m in db.messages} == set(FRAMES)
-    assert {n.name for n in db.nodes} == {"TCU", "VCU", "BENCH", "TOOL"}
+    assert {n.name for n in db.nodes} == {"TCU", "VCU", "BENCH", "TOOL", "ECU"}
 
 
 def test_cantools_dump_is_clean():
@@ -226,6 +231,9 @@ static const struct { const char *name; const wc_can_signal_t *sig; } sigs[] = {
     SIG(adaptation_report, image_invalid), SIG(adaptation_report, friction_scale),
     SIG(adaptation_report, friction_scale_change), SIG(adaptation_report, confidence),
     SIG(adaptation_report, film_factor), SIG(adaptation_report, kiss_offset),
+    SIG(offgoing_sensors, offgoing_slip_speed), SIG(offgoing_vfs_command, shift_phase),
+    SIG(offgoing_vfs_command, vfs_current), SIG(offgoing_vfs_command, pressure_command),
+    SIG(engine_torque_request, intervention_active), SIG(engine_torque_request, torque_delta),
 };
 
 static float F(const char *s) { return strtof(s, NULL); }

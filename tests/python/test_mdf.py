@@ -16,7 +16,7 @@ from wetclutch.util import canlog, mdf
 
 # The DBC's enumerations (value names for every raw value of the valid range): stored with a value-to-text
 # conversion. The other value names (SNA) make a status-string table: the name reads as NaN.
-ENUMS = {"Mode", "LockState", "AbortReason"}
+ENUMS = {"Mode", "LockState", "AbortReason", "Fallback"}
 
 
 def assert_matches_dbc(path, messages) -> dict:

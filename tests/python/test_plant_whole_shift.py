@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wetclutch.generate import vehicle_cal
+from wetclutch.shift import vehicle_cal
 from wetclutch.simulate import plant
 
 DT = plant.DT_S

@@ -288,7 +288,7 @@ def _cmd_shift(args) -> int:
 
 
 def _cmd_vehicle_cal(args) -> int:
-    from .generate import vehicle_cal
+    from .shift import vehicle_cal
     argv = ([args.plants_dir] if args.plants_dir else []) + (["--out", args.out] if args.out else [])
     return vehicle_cal.main(argv)
 

@@ -53,7 +53,9 @@ runner      one shift and a scenario's shifts (run_case), their frames (record_m
             run_on_vcan (guest: __main__.py)
 quality     the quality vector of a shift, a scenario's worst
 comparison  the matrix x controllers, the feedback gains' search, the targets, the report (and its MDF4 files)
-plots       the Fig. 4-style panels of a scenario
+plots       the Fig. 4-style panels of a scenario (plot_case; plot_whole_case: both clutches and the engine)
+whole       the whole shift (issue 22, DESIGN 14): the vehicle family, its scenarios and faults, targets, report
+vehicle_cal the TCU's driveline model of each vehicle plant (`wetclutch vehicle-cal`)
 """
 from __future__ import annotations
 

@@ -55,7 +55,7 @@ without the new parameters are bit for bit the plant before it:
       output_torque_Nm (i2 T_c + i1 T_off), vfs_pressure_Pa appended; turbine_torque_Nm = the actual engine torque.
 
 Plant files may extend a base (extends = "base.toml"): tools/plants/vehicles/ is a family of vehicles on
-nominal.toml (params has the rules; wetclutch.generate.vehicle_cal their TCU driveline models).
+nominal.toml (params has the rules; wetclutch.shift.vehicle_cal their TCU driveline models).
 
 Stick-slip (each clutch): a locked clutch carries the torque the rigid
 constraint needs (the constrained two-inertia system solved for it, the other
