@@ -26,22 +26,23 @@ pytestmark = needs_vcan
 GUEST = r"""
 set -u
 out=$1; tcu=$2
-candump -L vcan0 > "$out/capture.log" & dump=$!
+. "$3"   # hil/capture.sh: candump on the guest's tmpfs (over 9p it lags the bus and misses frames under load)
+capture_start "$out/capture.log" vcan0
 "$tcu" --iface vcan0 --clock frame --calibration table1 --stats-json "$out/stats.json" 2> "$out/tcu.txt" & tcu_pid=$!
 sleep 0.5
 canplayer -I "$out/before.log" vcan0=vcan0
 ip link set vcan0 down
+capture_stop 8   # candump (can-utils 2020.11) ends when its interface goes down: a second capture after it
 sleep 0.5
 ip link set vcan0 up
-# candump (can-utils 2020.11) ends when its interface goes down: a second capture
-candump -L vcan0 > "$out/capture_after.log" & dump2=$!
-sleep 0.3
+capture_start "$out/capture_after.log" vcan0
+sleep 1.0        # candump bound before the first frame (0.3 s was too short in a loaded guest: it missed it)
 canplayer -I "$out/after.log" vcan0=vcan0
 sleep 0.5
 # markers in their own file: wc_tcu's stderr (tcu.txt) has its own file offset
 kill -0 "$tcu_pid" && echo "wc_tcu still running" >> "$out/guest.txt"
 kill -TERM "$tcu_pid"; wait "$tcu_pid"; echo "wc_tcu exit $?" >> "$out/guest.txt"
-sleep 0.5; kill "$dump" "$dump2" 2>/dev/null; wait "$dump" "$dump2" 2>/dev/null || true
+capture_stop
 """
 
 
@@ -59,7 +60,7 @@ def test_interface_down_and_up(tmp_path, tcu):
     out.mkdir()
     _logs(out)
     run = subprocess.run(["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out), "--",
-                          "bash", "-c", GUEST, "guest", str(out), str(tcu)],
+                          "bash", "-c", GUEST, "guest", str(out), str(tcu), str(ROOT / "hil" / "capture.sh")],
                          cwd=ROOT, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=900)
     text = (out / "tcu.txt").read_text()
     guest = (out / "guest.txt").read_text() if (out / "guest.txt").exists() else ""
