@@ -603,7 +603,7 @@ static WC_NOINLINE void fill_pulse(const wc_shift_t *shift, const wc_shift_calib
 {
     const wc_calibration_t *c = clutch->model.cal;
     if ((c == NULL) || (shift->phase != (uint32_t)WC_SHIFT_PREPARE) ||
-        (shift->phase_periods > periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
+        (shift->phase_periods >= periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
         return;
     }
     const float i = cal->fill_pulse_current_mA;
