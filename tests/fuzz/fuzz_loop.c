@@ -17,6 +17,14 @@
  *           adaptation on, DESIGN 12; bench input off, and the
  *           BenchMeasurement choice of the frame id below is ShiftCommand,
  *           E2E-valid and plausible like the other control frames, Mode 0..3).
+ *   with bit 7, one more byte (after the configuration bytes): bit 0 the
+ *           whole shift (DESIGN 14): config.shift = shift_1_2 whole_full
+ *           (coordinator 1, engine intervention; bit 1 of byte 0 no longer
+ *           picks adaptive) and config.offgoing = the table1 calibration (the
+ *           on-coming clutch's); the third ClutchSensors choice of the frame
+ *           id below is then OffgoingSensors (E2E-valid and plausible like the
+ *           other control frames, its own alive counter; raw bytes give SNA
+ *           and out-of-range values); bits 1-7 unused.
  *   then records until the bytes run out (at most MAX_RECORDS), each a
  *   command byte c:
  *     c & 3 == 0  a timer tick without a frame
@@ -55,6 +63,8 @@
  * Oracle after every wc_loop_iterate (abort with a message on violation):
  *  - it returns WC_LOOP_TX_CYCLIC exactly when the clock says so (a tick, or
  *    with the frame clock a ClutchSensors frame without flags), else 0;
+ *    the step's frames are the cyclic ones (2; 4 with the whole shift), then
+ *    ShiftReport, then AdaptationReport;
  *  - the step's frames: VfsCommand (0x120, DLC 8) decodes with a good CRC,
  *    its alive counter counts +1, reserved status bits are 0; VfsCurrent
  *    within the calibration's current range, and the model's own output
@@ -70,6 +80,32 @@
  *    inside their bands (wc_adapt_values_valid) after every step;
  *  - counters: frames_used + sum(rejected) + frames still queued ==
  *    frames_in; frames_out == the frames the steps returned;
+ *  - the whole shift (wc_loop_whole_shift): frames 2 and 3 are
+ *    OffgoingVfsCommand (0x124) and EngineTorqueRequest (0x125), DLC 8, no
+ *    flags; both decode without error (E2E CRC right, no SNA, no range
+ *    error), their alive counters count +1 per step, every decoded value is
+ *    finite and inside its DBC range; OffgoingVfsCommand: VfsCurrent within
+ *    the off-going calibration's current range and the off-going model's own
+ *    output (loop->offgoing_last, finite) within half a bit of it, ShiftPhase
+ *    and Fallback those of the controller; EngineTorqueRequest:
+ *    InterventionActive 0/1 as loop->whole.engine_active, TorqueDelta within
+ *    [-engine_reduction_max_Nm, engine_increase_max_Nm] of the shift
+ *    calibration (the widest the loop ran on: an XCP page may narrow them
+ *    during a ramp-out) and 0 when InterventionActive is 0; in the safe
+ *    state (README, "Fault in the middle of a shift"; wc_shift.c fall_back,
+ *    offgoing_input): InterventionActive 0, the off-going current exactly its
+ *    calibrated maximum (held 1st gear: IDLE, hand-back) or minimum
+ *    (released); by the controller's state (its Fallback may be the last
+ *    shift's): outside Shift mode the minimum (not the loop's clutch: also
+ *    outside the safe state, with no engine request); without second gear
+ *    (IDLE, PREPARE, TORQUE, a hand-back) the maximum; with it (inertia phase
+ *    on: Fallback 1 finished on the model, 3 released) the minimum once the
+ *    hand-over into the inertia phase is over (until then, at most
+ *    WC_SHIFT_HANDOVER_MAX_s, it tracks as wc_shift.c offgoing_input does;
+ *    WC_FUZZ_STRICT_FALLBACK=1: released at once, as the README's fault
+ *    table says); the on-coming clutch at its minimum as without the whole
+ *    shift except while a shift finishes on the model (Fallback 1, INERTIA
+ *    .. LOCKED: the on-coming clutch as planned, only its range checked);
  *  - the current range, the safe state's minimum and the recovery debounce
  *    are those of the calibration the loop uses now (an accepted XCP page
  *    may change them);
@@ -79,8 +115,9 @@
  *    calibration changes; wc_calibration_check is costly) the loop's
  *    calibration passes
  *    wc_calibration_check (and its shift calibration
- *    wc_shift_calibration_check), its control period and shift control's
- *    presence are the ones it started with; the loop's own frames are in
+ *    wc_shift_calibration_check, the off-going clutch's calibration
+ *    wc_calibration_check), its control period, shift control's and the
+ *    whole shift's presence are the ones it started with; the loop's own frames are in
  *    their own array (VfsCommand first, checked above).
  * At the end one more tick empties the ring and the counters must add up
  * with nothing queued. */
@@ -101,6 +138,7 @@
 
 static const wc_calibration_t *const cal = &wc_table1_calibration;
 static bool verbose;
+static bool strict_fallback;  /* WC_FUZZ_STRICT_FALLBACK=1: no hand-over in the safe state (README's fault table) */
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -110,6 +148,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     (void)argc;
     (void)argv;
     verbose = fz_env_flag("WC_FUZZ_VERBOSE");
+    strict_fallback = fz_env_flag("WC_FUZZ_STRICT_FALLBACK");
     return 0;
 }
 
@@ -121,7 +160,19 @@ typedef struct {
     uint8_t alive_sensors;   /* next alive counter of each E2E frame ("make valid") */
     uint8_t alive_request;
     uint8_t alive_shift;
+    uint8_t alive_offgoing;
     bool shift;              /* shift control on */
+    bool whole;              /* the whole shift (wc_loop_whole_shift) */
+    bool have_whole_tx;      /* OffgoingVfsCommand/EngineTorqueRequest seen: their counters must count */
+    uint8_t offgoing_alive;
+    uint8_t engine_alive;
+    float engine_increase_max_Nm;   /* the widest engine limits of the shift calibrations the loop ran on */
+    float engine_reduction_max_Nm;
+    uint32_t engine_steps;   /* statistics for WC_FUZZ_VERBOSE: InterventionActive, fallback in the safe state */
+    uint32_t fallback_steps;
+    bool shift_stepped;      /* the step ran the shift controller (Shift mode, or a shift running before it) */
+    uint32_t reports;        /* ShiftReports, and the last one's AbortReason (WC_FUZZ_VERBOSE) */
+    uint8_t last_abort;
     uint32_t frames_out;     /* frames the steps returned */
     bool have_tx;            /* a VfsCommand was seen: its counter must count */
     uint8_t tx_alive;
@@ -165,6 +216,7 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     memset(f, 0, sizeof *f);
     f->id = (sel < 7u) ? ids[sel] : (uint32_t)fz_u16(r);
     if ((sel == 6u) && h->shift) { f->id = WC_CAN_SHIFT_COMMAND_FRAME_ID; }
+    if ((sel == 2u) && h->whole) { f->id = WC_CAN_OFFGOING_SENSORS_FRAME_ID; }
     const uint8_t format = fz_u8(r);
     if ((format & 0x80u) != 0u) {
         f->dlc = (uint8_t)(format & 0x0Fu);
@@ -179,7 +231,11 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     const bool request = (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID);
     const bool bench = (f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID);
     const bool shift = h->shift && (f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID);
-    if (h->plausible && (fault != 3u) && shift) {
+    const bool offgoing = h->whole && (f->id == WC_CAN_OFFGOING_SENSORS_FRAME_ID);
+    if (h->plausible && (fault != 3u) && offgoing) {
+        const wc_can_offgoing_sensors_phys_t o = { map_u16(fz_u16(r), -8000.0f, 8000.0f), 0u };
+        (void)wc_can_encode_offgoing_sensors(f->data, &o, sizeof f->data);
+    } else if (h->plausible && (fault != 3u) && shift) {
         const wc_can_shift_command_phys_t s = {
             (float)(fz_u8(r) & 1u), (float)(fz_u8(r) & 1u) /* AdaptationReset */, (float)(fz_u8(r) % 8u + 1u),
             map_u16(fz_u16(r), -1000.0f, 1000.0f),
@@ -204,8 +260,9 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
     } else {
         for (size_t i = 0u; i < sizeof f->data; ++i) { f->data[i] = fz_u8(r); }
     }
-    if (!h->make_valid || !(sensors || request || shift) || (fault == 3u)) { return; }
-    uint8_t *alive = sensors ? &h->alive_sensors : (request ? &h->alive_request : &h->alive_shift);
+    if (!h->make_valid || !(sensors || request || shift || offgoing) || (fault == 3u)) { return; }
+    uint8_t *alive = sensors ? &h->alive_sensors
+                             : (request ? &h->alive_request : (shift ? &h->alive_shift : &h->alive_offgoing));
     if (fault == 1u) {  /* counter = previous + delta: 0 repeats, 2 loses one frame, ... */
         const uint8_t delta = (uint8_t)(fz_u8(r) & WC_E2E_COUNTER_MASK);
         *alive = (uint8_t)((*alive + delta + 15u) % 16u);
@@ -233,6 +290,138 @@ static void check_counters(const harness_t *h)
     FZ_CHECK((loop.counters.steps == h->steps) && (loop.counters.frames_out == h->frames_out),
              "steps %u (harness %u), frames out %u", (unsigned)loop.counters.steps, (unsigned)h->steps,
              (unsigned)loop.counters.frames_out);
+}
+
+/* The whole shift's two cyclic frames (out[2], out[3]) and the off-going clutch after a step. */
+static void check_whole(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES], bool safe)
+{
+    const wc_calibration_t *og_cal = loop.offgoing.model.cal;  /* an accepted XCP page may have changed it */
+    const wc_shift_calibration_t *sc = loop.config.shift;
+    const float i_min = og_cal->vfs_current_min_mA;
+    const float i_max = og_cal->vfs_current_max_mA;
+    const float lsb_mA = 1.0f / 32.0f;  /* VfsCurrent scaling */
+    const float lsb_Nm = 0.05f;         /* TorqueDelta scaling */
+    if (sc->engine_increase_max_Nm > h->engine_increase_max_Nm) { h->engine_increase_max_Nm = sc->engine_increase_max_Nm; }
+    if (sc->engine_reduction_max_Nm > h->engine_reduction_max_Nm) { h->engine_reduction_max_Nm = sc->engine_reduction_max_Nm; }
+
+    /* the off-going clutch's own model output (the frame would hide a NaN as 0 mA) */
+    const wc_step_output_t *o = &loop.offgoing_last;
+    FZ_CHECK(fz_finite(o->current_mA) && (o->current_mA >= i_min) && (o->current_mA <= i_max),
+             "off-going model current %g outside [%g, %g]", (double)o->current_mA, (double)i_min, (double)i_max);
+    FZ_CHECK(fz_finite(o->pressure_command_Pa) && fz_finite(o->pressure_model_Pa) && fz_finite(o->force_command_N) &&
+                 fz_finite(o->theta_degC) && fz_finite(o->model.torque_Nm) && fz_finite(o->model.hbar_m) &&
+                 fz_finite(o->model.mu_f) && (o->model.hbar_m > 0.0f),
+             "non-finite off-going output: P %g Pm %g F %g theta %g T %g hbar %g mu_f %g",
+             (double)o->pressure_command_Pa, (double)o->pressure_model_Pa, (double)o->force_command_N,
+             (double)o->theta_degC, (double)o->model.torque_Nm, (double)o->model.hbar_m, (double)o->model.mu_f);
+    FZ_CHECK((loop.offgoing.theta_degC >= WC_THETA_MIN_degC) && (loop.offgoing.theta_degC <= WC_THETA_MAX_degC),
+             "off-going estimate %g outside the envelope", (double)loop.offgoing.theta_degC);
+    FZ_CHECK((o->status & WC_STATUS_NOT_INITIALISED) == 0u, "off-going model status 0x%x", (unsigned)o->status);
+
+    /* OffgoingVfsCommand */
+    FZ_CHECK((out[2].id == WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID) && (out[2].dlc == 8u) && (out[2].flags == 0u),
+             "third frame id 0x%x dlc %u flags %u (OffgoingVfsCommand expected)", (unsigned)out[2].id,
+             (unsigned)out[2].dlc, (unsigned)out[2].flags);
+    wc_can_offgoing_vfs_command_phys_t og;
+    const wc_can_result_t ro = wc_can_decode_offgoing_vfs_command(&og, out[2].data, out[2].dlc);
+    FZ_CHECK(!wc_can_is_error(ro), "OffgoingVfsCommand does not decode cleanly (result %d)", (int)ro);
+    FZ_CHECK(fz_finite(og.vfs_current_mA) && fz_finite(og.pressure_command_kPa) && fz_finite(og.shift_phase) &&
+                 (og.vfs_current_mA >= 0.0f) && (og.vfs_current_mA <= 2000.0f) && (og.pressure_command_kPa >= 0.0f) &&
+                 (og.pressure_command_kPa <= 4000.0f) && (og.shift_phase >= 0.0f) && (og.shift_phase <= 6.0f) &&
+                 (og.fallback <= WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_RELEASED_CHOICE),
+             "OffgoingVfsCommand outside the DBC: current %g pressure %g phase %g fallback %u",
+             (double)og.vfs_current_mA, (double)og.pressure_command_kPa, (double)og.shift_phase, (unsigned)og.fallback);
+    FZ_CHECK((og.shift_phase == (float)loop.shift.phase) && (og.fallback == loop.shift.fallback),
+             "OffgoingVfsCommand phase %g fallback %u, controller %u %u", (double)og.shift_phase,
+             (unsigned)og.fallback, (unsigned)loop.shift.phase, (unsigned)loop.shift.fallback);
+    FZ_CHECK((og.vfs_current_mA >= i_min - 0.5f * lsb_mA) && (og.vfs_current_mA <= i_max + 0.5f * lsb_mA) &&
+                 (fabsf(og.vfs_current_mA - o->current_mA) <= 0.5f * lsb_mA),
+             "off-going VfsCurrent %g, model current %g, range [%g, %g]", (double)og.vfs_current_mA,
+             (double)o->current_mA, (double)i_min, (double)i_max);
+
+    /* EngineTorqueRequest */
+    FZ_CHECK((out[3].id == WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID) && (out[3].dlc == 8u) && (out[3].flags == 0u),
+             "fourth frame id 0x%x dlc %u flags %u (EngineTorqueRequest expected)", (unsigned)out[3].id,
+             (unsigned)out[3].dlc, (unsigned)out[3].flags);
+    wc_can_engine_torque_request_phys_t eng;
+    const wc_can_result_t rq = wc_can_decode_engine_torque_request(&eng, out[3].data, out[3].dlc);
+    FZ_CHECK(!wc_can_is_error(rq), "EngineTorqueRequest does not decode cleanly (result %d)", (int)rq);
+    FZ_CHECK(fz_finite(eng.intervention_active) && fz_finite(eng.torque_delta_Nm) &&
+                 ((eng.intervention_active == 0.0f) || (eng.intervention_active == 1.0f)) &&
+                 (eng.torque_delta_Nm >= -1000.0f) && (eng.torque_delta_Nm <= 1000.0f),
+             "EngineTorqueRequest outside the DBC: active %g delta %g", (double)eng.intervention_active,
+             (double)eng.torque_delta_Nm);
+    const bool active = eng.intervention_active == 1.0f;
+    FZ_CHECK(active == loop.whole.engine_active, "InterventionActive %g, controller %d", (double)eng.intervention_active,
+             (int)loop.whole.engine_active);
+    FZ_CHECK((eng.torque_delta_Nm >= -h->engine_reduction_max_Nm - 0.5f * lsb_Nm) &&
+                 (eng.torque_delta_Nm <= h->engine_increase_max_Nm + 0.5f * lsb_Nm),
+             "TorqueDelta %g outside [-%g, %g]", (double)eng.torque_delta_Nm, (double)h->engine_reduction_max_Nm,
+             (double)h->engine_increase_max_Nm);
+    if (active) {
+        FZ_CHECK(fz_finite(loop.whole.engine_delta_Nm) && (fabsf(eng.torque_delta_Nm - loop.whole.engine_delta_Nm) <= 0.5f * lsb_Nm),
+                 "TorqueDelta %g, controller %g", (double)eng.torque_delta_Nm, (double)loop.whole.engine_delta_Nm);
+        h->engine_steps++;
+    } else {
+        FZ_CHECK(eng.torque_delta_Nm == 0.0f, "TorqueDelta %g with InterventionActive 0", (double)eng.torque_delta_Nm);
+    }
+
+    /* alive counters: +1 per step, each frame its own */
+    if (h->have_whole_tx) {
+        FZ_CHECK(og.alive_counter == (uint8_t)((h->offgoing_alive + 1u) % 16u),
+                 "OffgoingVfsCommand alive counter %u after %u", (unsigned)og.alive_counter, (unsigned)h->offgoing_alive);
+        FZ_CHECK(eng.alive_counter == (uint8_t)((h->engine_alive + 1u) % 16u),
+                 "EngineTorqueRequest alive counter %u after %u", (unsigned)eng.alive_counter, (unsigned)h->engine_alive);
+    }
+    h->have_whole_tx = true;
+    h->offgoing_alive = og.alive_counter;
+    h->engine_alive = eng.alive_counter;
+
+    /* outside Shift mode (no shift running) the off-going clutch is not the loop's: open, no engine request
+     * (wc_loop.c run) */
+    if (!h->shift_stepped) {
+        FZ_CHECK((o->current_mA == i_min) && !active, "not in Shift mode: off-going current %g mA (minimum %g), "
+                 "InterventionActive %g", (double)o->current_mA, (double)i_min, (double)eng.intervention_active);
+    }
+
+    /* the safe state (README, "Fault in the middle of a shift"; wc_shift.c fall_back, offgoing_input); the
+     * fallback of the last shift stays in the controller after it (sent in OffgoingVfsCommand.Fallback): its
+     * rows only when the controller stepped */
+    if (safe) {
+        FZ_CHECK(!active, "InterventionActive in the safe state (delta %g)", (double)eng.torque_delta_Nm);
+        const bool at_max = (o->current_mA == i_max) && (fabsf(og.vfs_current_mA - i_max) <= 0.5f * lsb_mA);
+        const bool at_min = (o->current_mA == i_min) && (fabsf(og.vfs_current_mA - i_min) <= 0.5f * lsb_mA);
+        /* wc_shift.c offgoing_input: into the inertia phase the off-going clutch goes on tracking what it
+         * carries until its slip shows the hand-over or WC_SHIFT_HANDOVER_MAX_s have passed, whether the loop is
+         * in its safe state or not (its slip then the held one); the README's fault table says "off-going
+         * released" for a fallback there: WC_FUZZ_STRICT_FALLBACK=1 checks that instead. */
+        const float dt_s = loop.clutch.model.cal->control_period_s;
+        const bool handing_over = !strict_fallback && loop.shift.second_gear && !loop.shift.offgoing_released;
+        if (handing_over && (loop.shift.phase == (uint32_t)WC_SHIFT_INERTIA)) {
+            FZ_CHECK((float)loop.shift.phase_periods * dt_s <= WC_SHIFT_HANDOVER_MAX_s + dt_s,
+                     "safe state: the off-going clutch still hands over %u periods into the inertia phase",
+                     (unsigned)loop.shift.phase_periods);
+        }
+        FZ_CHECK(at_max || at_min || handing_over,
+                 "safe state: off-going current %g mA (frame %g) neither its maximum %g nor minimum %g (phase %u, "
+                 "fallback %u, second gear %d)",
+                 (double)o->current_mA, (double)og.vfs_current_mA, (double)i_max, (double)i_min,
+                 (unsigned)loop.shift.phase, (unsigned)loop.shift.fallback, (int)loop.shift.second_gear);
+        /* wc_shift.c offgoing_input, by the controller's state (its Fallback may be the last shift's): without
+         * second gear (IDLE, PREPARE, TORQUE, a hand-back's ABORTED) it holds 1st gear at its maximum; with it
+         * (INERTIA on; FINISH, RELEASED) it is released once the hand-over is over */
+        if (h->shift_stepped && !loop.shift.second_gear) {
+            FZ_CHECK(at_max, "safe state without second gear: off-going current %g mA, maximum %g (phase %u, "
+                     "fallback %u)", (double)o->current_mA, (double)i_max, (unsigned)loop.shift.phase,
+                     (unsigned)loop.shift.fallback);
+        } else if (h->shift_stepped && !handing_over) {
+            FZ_CHECK(at_min, "safe state, second gear: off-going current %g mA, not released (minimum %g; phase %u, "
+                     "fallback %u, released %d)", (double)o->current_mA, (double)i_min, (unsigned)loop.shift.phase,
+                     (unsigned)loop.shift.fallback, (int)loop.shift.offgoing_released);
+        }
+        const uint32_t fallback = h->shift_stepped ? loop.shift.fallback : (uint32_t)WC_SHIFT_FALLBACK_NONE;
+        if (fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE) { h->fallback_steps++; }
+    }
 }
 
 /* The frames and state after a step. */
@@ -289,9 +478,14 @@ static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES]
                  (unsigned)loop.config.recovery_periods);
         h->control_steps++;
     } else {
-        FZ_CHECK((o->current_mA == i_min) && (fabsf(cmd.vfs_current_mA - i_min) <= 0.5f * lsb_mA),
-                 "safe state with current %g mA (frame %g), minimum %g", (double)o->current_mA,
-                 (double)cmd.vfs_current_mA, (double)i_min);
+        /* the whole shift finished on the model (README: "on-coming clutch as planned"): its range only */
+        const bool finishing = h->whole && h->shift_stepped && (loop.shift.fallback == (uint32_t)WC_SHIFT_FALLBACK_FINISH) &&
+                               (wc_shift_phase_running(loop.shift.phase) || (loop.shift.phase == (uint32_t)WC_SHIFT_LOCKED));
+        if (!finishing) {
+            FZ_CHECK((o->current_mA == i_min) && (fabsf(cmd.vfs_current_mA - i_min) <= 0.5f * lsb_mA),
+                     "safe state with current %g mA (frame %g), minimum %g", (double)o->current_mA,
+                     (double)cmd.vfs_current_mA, (double)i_min);
+        }
         h->safe_steps++;
     }
     if (!h->config.bench_input_enabled) {
@@ -305,6 +499,7 @@ static void check_step(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES]
     const wc_can_result_t re = wc_can_decode_clutch_estimate(&est, out[1].data, out[1].dlc);
     FZ_CHECK(!wc_can_is_error(re), "ClutchEstimate does not decode cleanly (result %d: SNA = NaN sent, or range)",
              (int)re);
+    if (h->whole) { check_whole(h, out, safe); }
     check_counters(h);
 }
 
@@ -346,6 +541,13 @@ static void xcp_step(const harness_t *h, bool control_step, unsigned record)
              (double)now->control_period_s);
     FZ_CHECK((loop.config.shift != NULL) == h->shift, "shift control %s online",
              (loop.config.shift != NULL) ? "switched on" : "switched off");
+    FZ_CHECK(wc_loop_whole_shift(&loop.config) == h->whole, "the whole shift %s online",
+             h->whole ? "switched off" : "switched on");
+    if (h->whole) {
+        const wc_cal_error_t eo = wc_calibration_check(loop.offgoing.model.cal);
+        FZ_CHECK(eo == WC_CAL_OK, "the off-going clutch runs on a calibration the check refuses: %s",
+                 wc_cal_error_name(eo));
+    }
     if (loop.config.shift != NULL) {
         FZ_CHECK(wc_shift_calibration_check(loop.config.shift) == WC_SHIFT_CAL_OK,
                  "the loop runs on a shift calibration the check refuses");
@@ -434,22 +636,29 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
         fz_ctx.iargs[0] = (long)frame->id;
         fz_ctx.iargs[1] = (long)frame->dlc * 16 + frame->flags;
     }
+    const bool running_before = wc_shift_phase_running(loop.shift.phase);
     const uint32_t n = wc_loop_iterate(&loop, h->clock, frame, tick, out);
+    /* as wc_loop.c prepare: Mode is the last used TorqueRequest's (frames are processed only in the step) */
+    h->shift_stepped = h->shift && ((loop.request.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE) || running_before);
     const bool expected = tick || ((h->clock == WC_LOOP_CLOCK_FRAME) && (frame != NULL) &&
                                    (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
     const bool adaptive = h->shift && (loop.config.shift->adaptation == 1u);
-    const uint32_t most = !h->shift ? WC_LOOP_TX_CYCLIC : (adaptive ? WC_LOOP_TX_FRAMES : WC_LOOP_TX_CYCLIC + 1u);
-    FZ_CHECK(expected ? ((n >= WC_LOOP_TX_CYCLIC) && (n <= most)) : (n == 0u),
-             "wc_loop_iterate returned %u, expected %u..%u", (unsigned)n, expected ? (unsigned)WC_LOOP_TX_CYCLIC : 0u,
+    /* the cyclic frames: VfsCommand, ClutchEstimate (and OffgoingVfsCommand, EngineTorqueRequest: the whole shift) */
+    const uint32_t cyclic = WC_LOOP_TX_CYCLIC + (h->whole ? WC_LOOP_TX_WHOLE_SHIFT : 0u);
+    const uint32_t most = !h->shift ? cyclic : (adaptive ? cyclic + 2u : cyclic + 1u);
+    FZ_CHECK(expected ? ((n >= cyclic) && (n <= most) && (n <= WC_LOOP_TX_FRAMES)) : (n == 0u),
+             "wc_loop_iterate returned %u, expected %u..%u", (unsigned)n, expected ? (unsigned)cyclic : 0u,
              expected ? (unsigned)most : 0u);
-    for (uint32_t i = WC_LOOP_TX_CYCLIC; expected && (i < n); ++i) {
+    for (uint32_t i = cyclic; expected && (i < n); ++i) {
         FZ_CHECK((out[i].dlc == 8u) && (out[i].flags == 0u), "frame %u dlc %u flags %u", (unsigned)i,
                  (unsigned)out[i].dlc, (unsigned)out[i].flags);
         if (out[i].id == WC_CAN_SHIFT_REPORT_FRAME_ID) {
-            FZ_CHECK(i == WC_LOOP_TX_CYCLIC, "ShiftReport at position %u", (unsigned)i);
+            FZ_CHECK(i == cyclic, "ShiftReport at position %u", (unsigned)i);
             wc_can_shift_report_phys_t q;
             const wc_can_result_t rq = wc_can_decode_shift_report(&q, out[i].data, out[i].dlc);
             FZ_CHECK(!wc_can_is_error(rq), "ShiftReport does not decode cleanly (result %d)", (int)rq);
+            h->reports++;
+            h->last_abort = q.abort_reason;
         } else {
             FZ_CHECK(adaptive && (out[i].id == WC_CAN_ADAPTATION_REPORT_FRAME_ID), "frame %u id 0x%x", (unsigned)i,
                      (unsigned)out[i].id);
@@ -462,7 +671,7 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
         FZ_CHECK(wc_adapt_values_valid(&loop.adapt.values, loop.config.shift), "learned values outside their bands");
     }
     h->frames_out += n;
-    if (n >= WC_LOOP_TX_CYCLIC) {
+    if (n >= cyclic) {
         check_step(h, out);
     } else {
         check_counters(h);
@@ -494,12 +703,24 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     h.shift = (options & 0x80u) != 0u;
     h.config.bench_input_enabled = ((options & 0x02u) != 0u) && !h.shift;
     h.config.shift = !h.shift ? NULL : (((options & 0x02u) != 0u) ? &wc_shift_1_2_adaptive : &wc_shift_1_2_full);
+    const uint8_t shift_options = h.shift ? fz_u8(&r) : 0u;
+    if ((shift_options & 0x01u) != 0u) {  /* the whole shift: the off-going clutch as the on-coming one */
+        h.config.shift = &wc_shift_1_2_whole_full;
+        h.config.offgoing = cal;
+    }
+    h.whole = wc_loop_whole_shift(&h.config);
+    if (h.whole) {
+        h.engine_increase_max_Nm = h.config.shift->engine_increase_max_Nm;
+        h.engine_reduction_max_Nm = h.config.shift->engine_reduction_max_Nm;
+    }
 
     fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
     fz_arg(theta_start);
-    fz_ctx.iargs[0] = options;
+    fz_ctx.iargs[0] = options | (shift_options << 8);
     fz_ctx.iargs[1] = (long)h.config.recovery_periods;
     FZ_CHECK(wc_loop_init(&loop, cal, &h.config, theta_start) == WC_CAL_OK, "wc_loop_init failed");
+    FZ_CHECK(wc_loop_whole_shift(&loop.config) == h.whole, "the loop's whole shift %d, configured %d",
+             (int)wc_loop_whole_shift(&loop.config), (int)h.whole);
     xcp_on = false;
     xcp_tried = false;
     xcp_frames = 0u;
@@ -558,6 +779,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 (unsigned)loop.counters.rejected[WC_REJECT_FORMAT],
                 (unsigned)loop.counters.rejected[WC_REJECT_IMPLAUSIBLE],
                 (unsigned)loop.counters.rejected[WC_REJECT_OVERFLOW], (unsigned)loop.counters.rejected[WC_REJECT_SYNC]);
+        if (h.whole) {
+            fprintf(stderr, "fuzz_loop: whole shift: phase %u, fallback %u, engine intervention steps %u, safe steps "
+                            "with a fallback %u, sensor timeouts %u\n",
+                    (unsigned)loop.shift.phase, (unsigned)loop.shift.fallback, (unsigned)h.engine_steps,
+                    (unsigned)h.fallback_steps, (unsigned)loop.counters.sensor_timeouts);
+        }
+        if (h.shift) {
+            fprintf(stderr, "fuzz_loop: shift reports %u, the last AbortReason %u\n", (unsigned)h.reports,
+                    (unsigned)h.last_abort);
+        }
         if (xcp_on) {
             fprintf(stderr,
                     "fuzz_loop: xcp commands %u (errors %u, ignored %u, lost %u), frames out %u, pages accepted %u "

@@ -318,9 +318,125 @@ def xcp_seeds():
     return {"xcp_downloads": downloads, "xcp_daq": daq, "xcp_errors": errors}
 
 
+# The whole shift (fuzz_loop.c: byte 0 bit 7 shift control, then the shift-options byte, bit 0 the whole shift):
+# the third ClutchSensors choice is OffgoingSensors. A 1->2 upshift at a constant output speed: the turbine at
+# i1 w_o = 3000 rpm, the on-coming slip (i1 - i2) w_o, the off-going slip 0, until the inertia phase pulls the
+# turbine down to i2 w_o (on-coming slip 0, off-going slip -(i1 - i2) w_o).
+SEL_OFFGOING = 2
+MODE_SHIFT = 3
+W_O_RPM = 3000.0 / 4.7
+SLIP_12_RPM = (4.7 - 3.1) * W_O_RPM
+WHOLE_CONFIG = bytes([25, 25, 2, 2, 5])  # sensor/request timeout 25, MaxDeltaCounter 2, SyncCounter 2, recovery 5
+
+
+def p_sensors(slip, tick=True, fault=0, oil=80.0, housing=75.0):
+    return bytes([1 | (0x04 if tick else 0) | (SEL_SENSORS << 3) | (fault << 6), 0x00]) + u16_of(slip, -8000, 8000) + \
+        u16_of(oil, -40, 200) + u16_of(housing, -40, 200)
+
+
+def p_offgoing(slip, fault=0):
+    return bytes([1 | (SEL_OFFGOING << 3) | (fault << 6), 0x00]) + u16_of(slip, -8000, 8000)
+
+
+def p_shift(request, turbine_Nm=150.0, time_ms=250.0):
+    # ShiftRequest, AdaptationReset, TargetGear byte (% 8 + 1: 1 -> gear 2), TurbineTorque, TargetInertiaTime
+    return bytes([1 | (SEL_BENCH << 3), 0x00, request, 0, 1]) + u16_of(turbine_Nm, -1000, 1000) + \
+        u16_of(time_ms, 50, 2000)
+
+
+def p_request(torque_Nm=0.0, mode=MODE_SHIFT):
+    return bytes([1 | (SEL_REQUEST << 3), 0x00]) + u16_of(torque_Nm, 0, 2000) + bytes([mode])
+
+
+def smoothstep(x):
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def whole_periods(b, first, last, request, inertia_start=None, inertia_ms=250.0, offgoing_every=4, lost=()):
+    """Periods first..last-1: ClutchSensors (with the tick) every 2nd period, a bare tick between, OffgoingSensors
+    every offgoing_every, ShiftCommand and TorqueRequest (Shift mode) every 10th. lost: inputs not sent."""
+    for k in range(first, last):
+        x = 0.0 if inertia_start is None else (k - inertia_start) / inertia_ms
+        slip = SLIP_12_RPM * (1 - smoothstep(x))
+        if k % 10 == 0:
+            if "shift" not in lost:
+                b += p_shift(request)
+            if "request" not in lost:
+                b += p_request()
+        if k % offgoing_every == 0 and "offgoing" not in lost:
+            b += p_offgoing(slip - SLIP_12_RPM)
+        if k % 2 == 0 and "sensors" not in lost:
+            b += p_sensors(slip)
+        else:
+            b += bytes([0])
+    return b
+
+
+def loop_whole_shift():
+    """'make valid' + 'plausible', the whole shift: Shift mode idle (the off-going clutch holds 1st gear), the
+    request edge, fill, torque phase, inertia phase, lock-up, locked (ShiftReport), request withdrawn."""
+    b = bytes([0x80 | 0x40 | 0x08 | 0x04]) + WHOLE_CONFIG + bytes([0x01])
+    b = whole_periods(b, 0, 30, 0)
+    b = whole_periods(b, 30, 300, 1)
+    b = whole_periods(b, 300, 640, 1, inertia_start=300)
+    b = whole_periods(b, 640, 660, 0, inertia_start=300)
+    return b
+
+
+def loop_whole_shift_faults():
+    """The whole shift's faults: OffgoingSensors with a wrong CRC, a repeated and a jumped counter, then lost in
+    the torque phase (safe state: handed back, the off-going clutch at its maximum current); back, a new request
+    edge, and OffgoingSensors lost again in the inertia phase (finished on the model), then back."""
+    b = bytes([0x80 | 0x40 | 0x08 | 0x04]) + WHOLE_CONFIG + bytes([0x01])
+    b = whole_periods(b, 0, 30, 0)
+    b = whole_periods(b, 30, 120, 1)
+    b += p_offgoing(0.0, fault=2) + bytes([0x5A]) + bytes([0])       # CRC error
+    b += p_offgoing(0.0, fault=1) + bytes([0]) + bytes([0])          # repeated counter
+    b += p_offgoing(0.0, fault=1) + bytes([5]) + bytes([0])          # counter jump
+    b += bytes([1 | (SEL_OFFGOING << 3) | (3 << 6), 0x00]) + bytes(8) + bytes([0])  # as fuzzed: all zero, CRC wrong
+    b = whole_periods(b, 124, 170, 1, lost=("offgoing",))            # lost: timeout, hand-back
+    b = whole_periods(b, 170, 200, 0)                                # back; the request withdrawn
+    b = whole_periods(b, 200, 460, 1)
+    b = whole_periods(b, 460, 470, 1, lost=("offgoing",))
+    b = whole_periods(b, 470, 540, 1, inertia_start=470, lost=("offgoing",))  # lost into the inertia phase
+    b = whole_periods(b, 540, 800, 1, inertia_start=470)
+    return b
+
+
+def raw_offgoing(slip_raw):
+    return bytes(pack([(16, 16, slip_raw)]))
+
+
+def loop_whole_shift_raw():
+    """'make valid' with raw signals, the whole shift in Shift mode: OffgoingSensors in range, SNA (-32768),
+    out of range, DLC 4, extended; the TCU's frames every step."""
+    b = bytes([0x80 | 0x04]) + bytes([0x01])
+    good_s = sensors_frame(0, SLIP_12_RPM, 80.0, 75.0)
+    good_q = request_frame(0, 0.0, MODE_SHIFT)
+    shift = bytes(pack([(16, 4, 2), (24, 16, round(150.0 / 0.05)), (40, 12, 250)]))
+    for k in range(26):
+        b += rec_frame(SEL_BENCH, shift)
+        b += rec_frame(SEL_OFFGOING, raw_offgoing(0))
+        b += rec_frame(SEL_SENSORS, good_s)
+        b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    for raw in (-32768, 32001, -32001, 4, -40):                      # SNA, above, below the range, in range
+        b += rec_frame(SEL_OFFGOING, raw_offgoing(raw))
+        b += rec_frame(SEL_SENSORS, good_s)
+        b += rec_frame(SEL_REQUEST, good_q, tick=True)
+    b += rec_frame(SEL_OFFGOING, raw_offgoing(0), fmt=0x84)         # DLC 4
+    b += rec_frame(SEL_OFFGOING, raw_offgoing(0), fmt=0x98, tick=True, ext_bits=0x113)  # extended
+    for k in range(12):
+        b += bytes([0])                                             # ticks only: timeouts
+    return b
+
+
 def loop_seeds():
     return {
         **xcp_seeds(),
+        "whole_shift": loop_whole_shift(),
+        "whole_shift_faults": loop_whole_shift_faults(),
+        "whole_shift_raw": loop_whole_shift_raw(),
         "engagement_timer": loop_engagement(False),
         "engagement_frame_clock": loop_engagement(True),
         "engagement_bench": loop_engagement(False, bench=True),
