@@ -498,8 +498,10 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
             /* INERTIA .. LOCKED without second gear: cannot happen (set on entering INERTIA); open */
         }
     } else if ((phase == (uint32_t)WC_SHIFT_INERTIA) && !shift->offgoing_released) {
-        /* the hand-over's end: the off-going clutch slips backwards (the on-coming one holds the turbine) */
-        shift->offgoing_released = (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s) ||
+        /* the hand-over's end: the off-going clutch slips backwards (the on-coming one holds the turbine);
+         * a lost input ends it at once (the fallback releases it: its slip is not known) */
+        shift->offgoing_released = safe || (shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE) ||
+                                   (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s) ||
                                    ((float)shift->phase_periods * dt_s >= WC_SHIFT_HANDOVER_MAX_s);
         handing_over = !shift->offgoing_released;
     } else {

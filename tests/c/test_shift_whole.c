@@ -215,6 +215,25 @@ static void test_fault_in_inertia_phase_finishes_on_the_model(void **state)
     assert_true(r.on_out.current_mA > wc_table1_calibration.vfs_current_min_mA + 10.0f);  /* holds 2nd gear */
 }
 
+/* A lost input at the inertia phase's start, before the off-going clutch's
+ * slip has shown the hand-over: the fallback releases it at once (its slip is
+ * not known), as the fault table says. */
+static void test_fault_at_inertia_start_releases_the_offgoing_clutch(void **state)
+{
+    (void)state;
+    static rig_t r;
+    const wc_shift_calibration_t cal = whole_cal();
+    rig_init(&r, &cal);
+    rig_idle(&r, 50u);
+    run_until_phase(&r, WC_SHIFT_INERTIA, 600u);
+    for (uint32_t k = 0u; k < 50u; ++k) {
+        (void)rig_step(&r, true, true, false, true);
+        assert_float_equal(r.off_out.current_mA, wc_table1_calibration.vfs_current_min_mA, 1e-3f);
+        assert_false(r.og.engine_active);
+        assert_true(r.on_out.current_mA > wc_table1_calibration.vfs_current_min_mA + 10.0f);
+    }
+}
+
 /* A lost input that outlasts fallback_time_s: finished and held on the model
  * that long, then released (neither finishing nor handing back is possible). */
 static void test_long_fault_releases_after_fallback_time(void **state)
@@ -322,6 +341,7 @@ int main(void)
         cmocka_unit_test(test_whole_shift_phases_and_requests),
         cmocka_unit_test(test_fault_in_torque_phase_hands_back),
         cmocka_unit_test(test_fault_in_inertia_phase_finishes_on_the_model),
+        cmocka_unit_test(test_fault_at_inertia_start_releases_the_offgoing_clutch),
         cmocka_unit_test(test_long_fault_releases_after_fallback_time),
         cmocka_unit_test(test_coordinator_off_is_the_oncoming_controller),
         cmocka_unit_test(test_loop_whole_shift_frames),
