@@ -350,12 +350,15 @@ static void check_whole(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES
     const bool active = eng.intervention_active == 1.0f;
     FZ_CHECK(active == loop.whole.engine_active, "InterventionActive %g, controller %d", (double)eng.intervention_active,
              (int)loop.whole.engine_active);
-    FZ_CHECK((eng.torque_delta_Nm >= -h->engine_reduction_max_Nm - 0.5f * lsb_Nm) &&
-                 (eng.torque_delta_Nm <= h->engine_increase_max_Nm + 0.5f * lsb_Nm),
+    /* half an LSB, and a little: the encoder rounds ties away from zero, and 0.05 Nm is not exact in binary, so
+     * a tie (-129.325 Nm -> -129.35) is a few float ulps more than half an LSB off */
+    const float half_lsb_Nm = 0.5f * lsb_Nm * 1.001f;
+    FZ_CHECK((eng.torque_delta_Nm >= -h->engine_reduction_max_Nm - half_lsb_Nm) &&
+                 (eng.torque_delta_Nm <= h->engine_increase_max_Nm + half_lsb_Nm),
              "TorqueDelta %g outside [-%g, %g]", (double)eng.torque_delta_Nm, (double)h->engine_reduction_max_Nm,
              (double)h->engine_increase_max_Nm);
     if (active) {
-        FZ_CHECK(fz_finite(loop.whole.engine_delta_Nm) && (fabsf(eng.torque_delta_Nm - loop.whole.engine_delta_Nm) <= 0.5f * lsb_Nm),
+        FZ_CHECK(fz_finite(loop.whole.engine_delta_Nm) && (fabsf(eng.torque_delta_Nm - loop.whole.engine_delta_Nm) <= half_lsb_Nm),
                  "TorqueDelta %g, controller %g", (double)eng.torque_delta_Nm, (double)loop.whole.engine_delta_Nm);
         h->engine_steps++;
     } else {
