@@ -9,9 +9,9 @@ Two TCUs run the same firmware code:
   InprocTcu  `wc_replay --lockstep --shift NAME` through a pipe (the frame loop
              linked into a host program): fast, for the scenario matrix;
   VcanTcu    `wc_tcu --clock frame --shift NAME` on a SocketCAN interface
-             (python-can), natively or in the QEMU guest (hil/shift_guest.sh).
+             (python-can), natively or in the QEMU guest (hil/vcan_run.sh; runner.run_on_vcan).
 
-For the same case both give the same output frames (tests/python/test_shift.py).
+For the same case both give the same output frames (tests/python/test_whole_shift.py, the whole shift).
 
 Controllers compared (issue 13), variants of tools/calibrations/shift_1_2.toml:
 (a) feedback: PI only; (b) blind: 2-DOF, clutch temperature = oil; (c) full:
