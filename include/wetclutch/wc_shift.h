@@ -300,7 +300,6 @@ typedef struct {
     float driver_torque_Nm;        /* T_t0: the turbine torque at the command, before any intervention */
     float oncoming_torque_Nm;      /* the on-coming model's torque of the last step */
     float flare_integral_Nm;       /* off-going flare correction's integral */
-    float engine_delta_Nm;         /* the engine request of the last step */
     float engine_from_Nm;          /* the request when the reduction's recovery began */
     uint32_t fallback;             /* wc_shift_fallback_t of the running shift */
     uint32_t fallback_periods;     /* periods since the input was lost */

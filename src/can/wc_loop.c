@@ -28,18 +28,23 @@ static void input_reset(wc_loop_input_t *in)
     wc_e2e_receiver_init(&in->e2e);
 }
 
+/* The shift part of a configuration: a shift calibration that passes its
+ * check (which says which field fails), and with the whole shift (DESIGN 14)
+ * the off-going clutch's calibration. */
+static bool shift_config_usable(const wc_loop_config_t *config)
+{
+    if (config->shift == NULL) { return true; }
+    return (wc_shift_calibration_check(config->shift) == WC_SHIFT_CAL_OK) &&
+           ((config->shift->coordinator != 1u) || (config->offgoing != NULL));
+}
+
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC)
 {
     WC_ASSERT((loop != NULL) && (config != NULL));
     if ((loop == NULL) || (config == NULL)) { return WC_CAL_NULL; }
     memset(loop, 0, sizeof *loop);
-    if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
-        return WC_CAL_NULL;  /* wc_shift_calibration_check says which field */
-    }
-    if ((config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing == NULL)) {
-        return WC_CAL_NULL;  /* the whole shift needs the off-going clutch's calibration */
-    }
+    if (!shift_config_usable(config)) { return WC_CAL_NULL; }
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
     if (error != WC_CAL_OK) { return error; }
     if (wc_loop_whole_shift(config)) {
@@ -68,12 +73,9 @@ wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal,
 {
     WC_ASSERT((loop != NULL) && (cal != NULL) && (config != NULL));
     if ((loop == NULL) || (cal == NULL) || (config == NULL)) { return WC_CAL_NULL; }
-    if ((config->shift != NULL) && (wc_shift_calibration_check(config->shift) != WC_SHIFT_CAL_OK)) {
-        return WC_CAL_NULL;
-    }
-    /* the whole shift cannot be switched on or off online, nor run without the off-going calibration */
+    if (!shift_config_usable(config)) { return WC_CAL_NULL; }
+    /* the whole shift cannot be switched on or off online */
     if (wc_loop_whole_shift(config) != wc_loop_whole_shift(&loop->config)) { return WC_CAL_NULL; }
-    if ((config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing == NULL)) { return WC_CAL_NULL; }
     wc_model_t model;
     const wc_cal_error_t error = wc_model_init(&model, cal);  /* the check and the constants derived once */
     if (error != WC_CAL_OK) { return error; }

@@ -239,6 +239,12 @@ static float through_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *c
     return clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
 }
 
+/* The flare (DESIGN 14): the off-going clutch slipping forward, the turbine above the 1st-gear speed. */
+static float flare_slip_rad_s(const wc_shift_t *shift)
+{
+    return (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
+}
+
 /* The whole shift's torque phase (DESIGN 14): the on-coming clutch's share
  * of the turbine torque, a smoothstep over torque_phase_time_s (zero slope at
  * both ends: the off-going clutch's lagging release is not left behind at the
@@ -271,7 +277,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
             if (!coord) { return share_Nm * (float)(shift->phase_periods + 1u) / (float)n; }
             /* a flare (the off-going clutch slips forward) is also taken by the on-coming clutch, which takes
              * the torque over anyway and follows faster than the off-going one's falling pressure */
-            const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
+            const float flare_rad_s = flare_slip_rad_s(shift);
             return share_Nm * torque_phase_share(shift, cal, dt_s, 0.0f) +
                    cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm;
         }
@@ -324,6 +330,13 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     return cal->holding_torque_factor * hold_share_Nm;
 }
 
+/* The fallback in the state and in the running report. */
+static void set_fallback(wc_shift_t *shift, wc_shift_fallback_t fallback)
+{
+    shift->fallback = (uint32_t)fallback;
+    shift->report.fallback = (uint32_t)fallback;
+}
+
 /* A lost input (the loop's safe state) with the coordinator (DESIGN 14): the
  * fallback of the phase, the engine request withdrawn (engine_request). */
 static void fall_back(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
@@ -331,17 +344,14 @@ static void fall_back(wc_shift_t *shift, const wc_shift_calibration_t *cal, floa
     if (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) {
         if ((shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_TORQUE)) {
             /* the off-going clutch still has the gear: hand it back */
-            shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_HANDBACK;
-            shift->report.fallback = shift->fallback;
+            set_fallback(shift, WC_SHIFT_FALLBACK_HANDBACK);
             abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
             return;
         }
-        shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_FINISH;  /* inertia phase or later: finish on the model */
-        shift->report.fallback = shift->fallback;
+        set_fallback(shift, WC_SHIFT_FALLBACK_FINISH);  /* inertia phase or later: finish on the model */
     }
     if ((float)shift->fallback_periods * dt_s > cal->fallback_time_s) {
-        shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_RELEASED;  /* neither possible: released */
-        shift->report.fallback = shift->fallback;
+        set_fallback(shift, WC_SHIFT_FALLBACK_RELEASED);  /* neither possible: released */
         if (wc_shift_phase_running(shift->phase)) {
             abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
         } else {
@@ -459,9 +469,8 @@ static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibra
     } else {
         active = false;
     }
-    shift->engine_delta_Nm = active ? delta_Nm : 0.0f;
     og->engine_active = active;
-    og->engine_delta_Nm = shift->engine_delta_Nm;
+    og->engine_delta_Nm = active ? delta_Nm : 0.0f;
 }
 
 /* The off-going clutch's input (DESIGN 14; wc_shift_step steps it): it holds 1st gear at
@@ -508,20 +517,18 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
         /* second gear: open */
     }
     if (handing_over) {
-        {
-            const float carried_Nm = clamp_torque_Nm(through_Nm(shift, cal) - cal->turbine_ratio * oncoming_torque_Nm);
-            const float flare_rad_s = (shift->offgoing_slip_rad_s > 0.0f) ? shift->offgoing_slip_rad_s : 0.0f;
-            const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
-            shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
-            if (flare_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
-            in->mode = WC_MODE_TORQUE;
-            /* the margin tapers with the on-coming clutch's ramp: at the hand-over the off-going clutch
-             * holds nothing the on-coming one could fight (tie-up) */
-            const float taper = (phase == (uint32_t)WC_SHIFT_TORQUE) ? (1.0f - torque_phase_share(shift, cal, dt_s, 0.0f)) : 0.0f;
-            in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
-                                                    cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
-            in->carried_torque_Nm = carried_Nm;
-        }
+        const float carried_Nm = clamp_torque_Nm(through_Nm(shift, cal) - cal->turbine_ratio * oncoming_torque_Nm);
+        const float flare_rad_s = flare_slip_rad_s(shift);
+        const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
+        shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
+        if (flare_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
+        in->mode = WC_MODE_TORQUE;
+        /* the margin tapers with the on-coming clutch's ramp: at the hand-over the off-going clutch
+         * holds nothing the on-coming one could fight (tie-up) */
+        const float taper = (phase == (uint32_t)WC_SHIFT_TORQUE) ? (1.0f - torque_phase_share(shift, cal, dt_s, 0.0f)) : 0.0f;
+        in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
+                                                cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
+        in->carried_torque_Nm = carried_Nm;
     }
 }
 
@@ -654,9 +661,5 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
         (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
         engine_request(shift, cal, dt_s, offgoing);
     }
-    const bool ended = shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
-    if (coord && ended && (shift->phase == (uint32_t)WC_SHIFT_ABORTED) && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE)) {
-        report->fallback = (uint32_t)(shift->second_gear ? WC_SHIFT_FALLBACK_NONE : WC_SHIFT_FALLBACK_HANDBACK);
-    }
-    return ended;
+    return shift_after(shift, cal, clutch, adapt, out, report, phase_before, slip_rad_s, dt_s);
 }

@@ -112,6 +112,16 @@ static void run_until_phase(rig_t *r, wc_shift_phase_t phase, uint32_t max)
     assert_int_equal(r->shift.phase, phase);
 }
 
+/* A rig on whole_cal(), 50 periods idle in 1st gear (the off-going clutch locks
+ * in its model), then the shift requested until it reaches phase. */
+static void rig_shift_to(rig_t *r, wc_shift_phase_t phase, uint32_t max)
+{
+    const wc_shift_calibration_t cal = whole_cal();
+    rig_init(r, &cal);  /* copied into the rig */
+    rig_idle(r, 50u);
+    run_until_phase(r, phase, max);
+}
+
 static void test_whole_shift_phases_and_requests(void **state)
 {
     (void)state;
@@ -169,10 +179,7 @@ static void test_fault_in_torque_phase_hands_back(void **state)
 {
     (void)state;
     static rig_t r;
-    const wc_shift_calibration_t cal = whole_cal();
-    rig_init(&r, &cal);
-    rig_idle(&r, 50u);
-    run_until_phase(&r, WC_SHIFT_TORQUE, 300u);
+    rig_shift_to(&r, WC_SHIFT_TORQUE, 300u);
     for (uint32_t k = 0u; k < 30u; ++k) { (void)rig_step(&r, true, false, true, true); }
     assert_int_equal(r.shift.phase, WC_SHIFT_TORQUE);
     assert_true(rig_step(&r, true, true, false, true));  /* the first safe period ends the shift */
@@ -195,10 +202,7 @@ static void test_fault_in_inertia_phase_finishes_on_the_model(void **state)
 {
     (void)state;
     static rig_t r;
-    const wc_shift_calibration_t cal = whole_cal();
-    rig_init(&r, &cal);
-    rig_idle(&r, 50u);
-    run_until_phase(&r, WC_SHIFT_INERTIA, 600u);
+    rig_shift_to(&r, WC_SHIFT_INERTIA, 600u);
     for (uint32_t k = 0u; k < 100u; ++k) { (void)rig_step(&r, true, false, true, true); }
     assert_int_equal(r.shift.phase, WC_SHIFT_INERTIA);
     for (uint32_t k = 0u; k < 100u; ++k) {
@@ -222,10 +226,7 @@ static void test_fault_at_inertia_start_releases_the_offgoing_clutch(void **stat
 {
     (void)state;
     static rig_t r;
-    const wc_shift_calibration_t cal = whole_cal();
-    rig_init(&r, &cal);
-    rig_idle(&r, 50u);
-    run_until_phase(&r, WC_SHIFT_INERTIA, 600u);
+    rig_shift_to(&r, WC_SHIFT_INERTIA, 600u);
     for (uint32_t k = 0u; k < 50u; ++k) {
         (void)rig_step(&r, true, true, false, true);
         assert_float_equal(r.off_out.current_mA, wc_table1_calibration.vfs_current_min_mA, 1e-3f);
@@ -240,12 +241,9 @@ static void test_long_fault_releases_after_fallback_time(void **state)
 {
     (void)state;
     static rig_t r;
-    const wc_shift_calibration_t cal = whole_cal();
-    rig_init(&r, &cal);
-    rig_idle(&r, 50u);
-    run_until_phase(&r, WC_SHIFT_INERTIA, 600u);
+    rig_shift_to(&r, WC_SHIFT_INERTIA, 600u);
     for (uint32_t k = 0u; k < 100u; ++k) { (void)rig_step(&r, true, false, true, true); }
-    const uint32_t bound = (uint32_t)(cal.fallback_time_s / DT_s + 0.5f);
+    const uint32_t bound = (uint32_t)(r.cal.fallback_time_s / DT_s + 0.5f);
     uint32_t released_at = 0u;
     for (uint32_t k = 1u; k <= bound + 50u; ++k) {
         (void)rig_step(&r, true, true, false, true);

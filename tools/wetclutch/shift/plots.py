@@ -21,14 +21,7 @@ def plot_case(path: Path, runs: dict, title: str) -> None:
         k0 = rec["command_step"]
         t = rec["t_s"] - rec["t_s"][k0]
         lab = {"feedback": "(a) feedback", "blind": "(b) 2-DOF blind", "full": "(c) 2-DOF full", "nolag": "(c) no lag comp."}[ctrl]
-        ax = axes[0, 0]
-        ax.plot(t, rec["true_turbine_speed_rpm"], color=c, label=f"turbine {lab}")
-        if ctrl == "full":
-            ax.plot(t, rec["true_gear1_speed_rpm"], "k:", lw=1, label="1st-gear sync (i1 w_o)")
-            ax.plot(t, rec["true_gear2_speed_rpm"], "k--", lw=1, label="2nd-gear sync (i2 w_o)")
-        ax = axes[0, 1]
-        ax.plot(t, rec["true_slip_rad_s"] / plant_mod.RPM, color=c, label=f"slip {lab}")
-        ax.plot(t, rec["reference_slip_rad_s"] / plant_mod.RPM, color=c, ls="--", lw=1)
+        _speeds_and_slip(axes, t, rec, c, lab, "slip", ctrl == "full")
         ax = axes[1, 0]
         ax.plot(t, rec["true_clutch_torque_Nm"], color=c, label=f"true {lab}")
         ax.plot(t, rec["model_torque_Nm"], color=c, ls=":", lw=1)
@@ -59,14 +52,7 @@ def plot_whole_case(path: Path, runs: dict, title: str) -> None:
         k0 = rec["command_step"]
         t = rec["t_s"] - rec["t_s"][k0]
         full = ctrl == "whole_full"
-        ax = axes[0, 0]
-        ax.plot(t, rec["true_turbine_speed_rpm"], color=c, label=f"turbine {lab}")
-        if full:
-            ax.plot(t, rec["true_gear1_speed_rpm"], "k:", lw=1, label="1st-gear sync (i1 w_o)")
-            ax.plot(t, rec["true_gear2_speed_rpm"], "k--", lw=1, label="2nd-gear sync (i2 w_o)")
-        ax = axes[0, 1]
-        ax.plot(t, rec["true_slip_rad_s"] / plant_mod.RPM, color=c, label=f"on-coming slip {lab}")
-        ax.plot(t, rec["reference_slip_rad_s"] / plant_mod.RPM, color=c, ls="--", lw=1)
+        _speeds_and_slip(axes, t, rec, c, lab, "on-coming slip", full)
         ax = axes[1, 0]
         ax.plot(t, rec["true_clutch_torque_Nm"], color=c, label=f"on-coming {lab}")
         ax.plot(t, rec["true_offgoing_torque_Nm"], color=c, ls="-.", label=f"off-going {lab}")
@@ -86,6 +72,18 @@ def plot_whole_case(path: Path, runs: dict, title: str) -> None:
     plotting.style(axes[1, 1], ylabel="pressure (kPa)", title="piston pressures (on-coming solid, off-going dash-dot)",
                    legend={"fontsize": 7})
     _finish(fig, axes, "on-coming clutch temperature: true (solid), TCU estimate (dashed)", 1.3, title, path)
+
+
+def _speeds_and_slip(axes, t, rec, c, lab, slip_label: str, sync: bool) -> None:
+    """The top panels of both figures: turbine speed (and once the synchronous speeds), slip and its reference."""
+    ax = axes[0, 0]
+    ax.plot(t, rec["true_turbine_speed_rpm"], color=c, label=f"turbine {lab}")
+    if sync:
+        ax.plot(t, rec["true_gear1_speed_rpm"], "k:", lw=1, label="1st-gear sync (i1 w_o)")
+        ax.plot(t, rec["true_gear2_speed_rpm"], "k--", lw=1, label="2nd-gear sync (i2 w_o)")
+    ax = axes[0, 1]
+    ax.plot(t, rec["true_slip_rad_s"] / plant_mod.RPM, color=c, label=f"{slip_label} {lab}")
+    ax.plot(t, rec["reference_slip_rad_s"] / plant_mod.RPM, color=c, ls="--", lw=1)
 
 
 def _accel_and_temperature(axes, t, rec, c, lab) -> None:
