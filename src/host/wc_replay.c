@@ -35,6 +35,7 @@
 #include "wetclutch_can/wc_loop.h"
 #include "wc_adapt_file.h"
 #include "wc_cal_image_file.h"
+#include "wc_loop_stats.h"
 #include "wc_tcu_calibrations.h"
 
 static int parse_line(const char *line, double *t_s, wc_can_frame_t *frame)
@@ -112,10 +113,32 @@ static int set_shift_field(wc_shift_calibration_t *cal, const char *assignment)
     return -1;
 }
 
+/* --stats-json: the counters as wc_tcu writes them (no SocketCAN: nothing dropped, no send failed, no
+ * step times); a failed write is one line and exit 1, never a half-written file left behind. */
+static int write_stats(const char *path, const wc_loop_counters_t *counters)
+{
+    FILE *f = fopen(path, "w");
+    int failed = (f == NULL);
+    if (f != NULL) {
+        fprintf(f, "{\n");
+        wc_loop_stats_json_members(f, counters, 0u, 0u);
+        fprintf(f, "  \"step_time_us\": null\n}\n");
+        failed = (ferror(f) != 0);
+        failed |= (fclose(f) != 0);
+    }
+    if (failed) {
+        fprintf(stderr, "wc_replay: cannot write %s: %s\n", path, strerror(errno));
+        (void)remove(path);
+        return 1;
+    }
+    return 0;
+}
+
 #define USAGE "usage: wc_replay LOG|- [--bench] [--calibration NAME] [--theta-start DEGC (-40..250)]" \
               " [--shift NAME [--set FIELD=VALUE]... [--adaptation-file FILE]] [--lockstep]\n" \
               "       wc_replay LOG|- [--bench] --calibration-image FILE [--theta-start DEGC] [--adaptation-file FILE]" \
-              " [--lockstep]\n"
+              " [--lockstep]\n" \
+              "       --stats-json FILE: the loop's counters at the end, as wc_tcu --stats-json writes them\n"
 
 int main(int argc, char **argv)
 {
@@ -124,6 +147,7 @@ int main(int argc, char **argv)
     const char *adaptation_path = NULL;
     int lockstep = 0;
     const char *log_path = NULL;
+    const char *stats_path = NULL;  /* --stats-json */
     const char *calibration = "table1";
     const char *image_path = NULL;  /* --calibration-image */
     int calibration_given = 0;
@@ -152,6 +176,7 @@ int main(int argc, char **argv)
                  ((shift_name != NULL) || (image_path != NULL))) {
             adaptation_path = argv[++i];
         }
+        else if ((strcmp(argv[i], "--stats-json") == 0) && (i + 1 < argc)) { stats_path = argv[++i]; }
         else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; calibration_given = 1; }
         else if ((strcmp(argv[i], "--calibration-image") == 0) && (i + 1 < argc) && (image_path == NULL)) {
             image_path = argv[++i];
@@ -259,5 +284,5 @@ int main(int argc, char **argv)
         fprintf(stderr, "wc_replay: writing stdout failed\n");
         return 1;
     }
-    return 0;
+    return (stats_path != NULL) ? write_stats(stats_path, &loop.counters) : 0;
 }

@@ -29,6 +29,7 @@
 #include "wc_socketcan.h"
 #include "wc_adapt_file.h"
 #include "wc_cal_image_file.h"
+#include "wc_loop_stats.h"
 #include "wc_tcu_calibrations.h"
 #include "wc_xcp_signals.h"
 
@@ -226,24 +227,13 @@ static int parse_options(int argc, char **argv, options_t *o)
     return 0;
 }
 
-/* Indexed by wc_loop_reject_t, in its order: a reason added without a name fails to compile. */
-static const char *const reject_names[] = {"crc", "counter", "short", "unknown_id", "format", "implausible", "overflow",
-                                           "sync"};
-WC_STATIC_ASSERT(sizeof reject_names / sizeof reject_names[0] == WC_REJECT_REASONS, reject_names_cover_every_reason);
-
 static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx_errors, uint32_t rx_dropped,
                    const step_times_t *h)
 {
     static const double pct[] = {50.0, 90.0, 99.0, 99.9};
     if (json) {
-        fprintf(out, "{\n  \"frames_in\": %u,\n  \"frames_used\": %u,\n  \"frames_out\": %u,\n  \"tx_errors\": %llu,\n"
-                     "  \"rx_dropped_by_kernel\": %u,\n",
-                k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors, rx_dropped);
-        fprintf(out, "  \"rejected\": {");
-        for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, "%s\"%s\": %u", r ? ", " : "", reject_names[r], k->rejected[r]); }
-        fprintf(out, "},\n  \"sensor_timeouts\": %u,\n  \"request_timeouts\": %u,\n  \"safe_steps\": %u,\n"
-                     "  \"steps\": %u,\n  \"deadline_misses\": %u,\n  \"bus_errors\": %u,\n",
-                k->sensor_timeouts, k->request_timeouts, k->safe_steps, k->steps, k->deadline_misses, k->bus_errors);
+        fprintf(out, "{\n");
+        wc_loop_stats_json_members(out, k, tx_errors, rx_dropped);
         fprintf(out, "  \"step_time_us\": {\"max\": %.3f, \"p50\": %.3f, \"p90\": %.3f, \"p99\": %.3f, \"p99.9\": %.3f}\n}\n",
                 (double)h->max_ns / 1000.0, percentile_us(h, 50), percentile_us(h, 90), percentile_us(h, 99),
                 percentile_us(h, 99.9));
@@ -252,7 +242,7 @@ static void report(FILE *out, int json, const wc_loop_counters_t *k, uint64_t tx
     fprintf(out, "wc_tcu: frames in %u (used %u), out %u, send errors %llu, dropped by the kernel %u\n",
             k->frames_in, k->frames_used, k->frames_out, (unsigned long long)tx_errors, rx_dropped);
     fprintf(out, "wc_tcu: rejected:");
-    for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, " %s %u", reject_names[r], k->rejected[r]); }
+    for (int r = 0; r < WC_REJECT_REASONS; ++r) { fprintf(out, " %s %u", wc_loop_reject_names[r], k->rejected[r]); }
     fprintf(out, "\nwc_tcu: timeouts: sensors %u, request %u; steps %u (safe state %u); deadline misses %u;"
                  " bus errors and failed sends %u\n",
             k->sensor_timeouts, k->request_timeouts, k->steps, k->safe_steps, k->deadline_misses, k->bus_errors);

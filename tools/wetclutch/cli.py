@@ -129,10 +129,11 @@ def _cmd_vectors(args) -> int:
     return 0
 
 
-def _analyse_replay(calibration_path: str, log: Path, run_dir: Path, reference_check: bool) -> dict:
+def _analyse_replay(calibration_path: str, log: Path, run_dir: Path, reference_check: bool, where: str) -> dict:
     """report.analyse of one log in a worker process (the calibration loaded there)."""
     from .hil import report
-    return report.analyse(calibration.load(calibration_path), log, run_dir, reference_check=reference_check)
+    return report.analyse(calibration.load(calibration_path), log, run_dir, reference_check=reference_check,
+                          where=where)
 
 
 def _cmd_replay(args) -> int:
@@ -146,11 +147,16 @@ def _cmd_replay(args) -> int:
         for problem in check.problems():
             print(f"wetclutch replay: {log}: {problem}", file=sys.stderr)
         jobs.append((log, out_root / log.stem))
-    if not args.analyse_only:
+    compiled_in = lut.c_identifier(Path(args.calibration).stem)
+    where = report.IN_PROCESS if args.in_process else report.ON_VCAN
+    if args.in_process and not args.analyse_only:
+        print(f"wetclutch replay: {len(jobs)} log(s) to the frame loop in-process (wc_replay)", file=sys.stderr,
+              flush=True)
+        replay.run_in_process(jobs, frame_runs=2, calibration=compiled_in)
+    elif not args.analyse_only:
         print(f"wetclutch replay: {len(jobs)} log(s) on vcan0 (the VM boot takes about a minute where the"
               " kernel has no CAN)", file=sys.stderr, flush=True)
-        replay.run_on_vcan(jobs, frame_runs=2, timer_runs=1,
-                           calibration=lut.c_identifier(Path(args.calibration).stem))
+        replay.run_on_vcan(jobs, frame_runs=2, timer_runs=1, calibration=compiled_in)
     missed = []
     for log, _ in jobs:
         print(f"wetclutch replay: analysing {log.name}"
@@ -161,9 +167,9 @@ def _cmd_replay(args) -> int:
     if workers > 1:
         with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as pool:
             results = list(pool.map(_analyse_replay, [args.calibration] * len(jobs), [log for log, _ in jobs],
-                                    [run_dir for _, run_dir in jobs], [check] * len(jobs)))
+                                    [run_dir for _, run_dir in jobs], [check] * len(jobs), [where] * len(jobs)))
     else:
-        results = [report.analyse(cal, log, run_dir, reference_check=check) for log, run_dir in jobs]
+        results = [report.analyse(cal, log, run_dir, reference_check=check, where=where) for log, run_dir in jobs]
     for (log, run_dir), m in zip(jobs, results):
         print((run_dir / "summary.md").read_text())
         print(f"report: {run_dir}/summary.md, metrics.json, {Path(m['mdf']['path']).name},"
@@ -399,6 +405,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", default="out/replay", help="report directory, one folder per log (default out/replay)")
     q.add_argument("--calibration", "-c", default=DEFAULT_CAL,
                    help="calibration TOML; wc_tcu runs the compiled-in calibration of the same name (its stem)")
+    q.add_argument("--in-process", action="store_true",
+                   help="the same frame-clock runs with the same loop in-process (wc_replay): no vcan, no guest,"
+                   " no timer-clock run")
     q.add_argument("--analyse-only", action="store_true", help="do not run: analyse the captures already in --out")
     q.add_argument("--no-reference-check", action="store_true",
                    help="skip comparing every TCU step with the double-precision reference")

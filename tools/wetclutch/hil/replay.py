@@ -4,7 +4,10 @@ Pieces, usable alone:
   check_log      validate a candump -L log: parseable, time-ordered, no gaps,
                  ids known (what is wrong is reported with its line)
   run_on_vcan    hil/vcan_run.sh + hil/replay_guest.sh: wc_tcu on a live vcan0
-                 (native, or inside the QEMU guest), canplayer in, candump out
+                 (native, or inside the QEMU guest), wc_canplay in (lockstep on the
+                 TCU's answers with the frame clock) and recording the bus
+  run_in_process the same frame-clock runs with the same loop in-process (wc_replay):
+                 no kernel, no guest, the same frames
   loop_reference the frame loop of src/wc_loop.c re-implemented here (E2E,
                  plausibility, freshness, safe state) feeding model.clutch_steps
   compare        the TCU's output frames against the reference, step by step
@@ -92,15 +95,17 @@ def check_log(path: Path, period_s: float = 1e-3, gap_periods: float = 5.0) -> L
 
 def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None = None,
                 calibration: str = "table1", bench: bool = True, calibration_image: Path | None = None,
-                image_runs: int = 0) -> None:
+                image_runs: int = 0, shift: str | None = None, theta_start_degC: float | None = None) -> None:
     """Bring up vcan0 once (native, or one QEMU boot) and replay each (log, out_dir)
-    of jobs, wc_tcu with --bench unless bench is False; image_runs more frame-clock runs with
-    wc_tcu --calibration-image calibration_image (image<n>.*). Progress goes to stderr.
+    of jobs, wc_tcu with --bench unless bench is False, --shift shift when given; image_runs more
+    frame-clock runs with wc_tcu --calibration-image calibration_image (image<n>.*). theta_start_degC:
+    the observer's start (default: the log's, theta_start_degC_of). Progress goes to stderr.
     Raises on failure."""
-    tcu = tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
-    if not tcu.is_file():
-        raise FileNotFoundError(f"{tcu}: TCU program not built (cmake --preset host-release &&"
-                                " cmake --build --preset host-release)")
+    tcu = Path(tcu or ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu")
+    for program in (tcu, tcu.parent / "wc_canplay"):
+        if not program.is_file():
+            raise FileNotFoundError(f"{program}: not built (cmake --preset host-release &&"
+                                    " cmake --build --preset host-release)")
     script = []
     shared = []   # one writable share per output parent: every share is on the guest kernel's command line
     for job_log, job_out in jobs:
@@ -108,11 +113,12 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
         job_out.mkdir(parents=True, exist_ok=True)
         if job_out.parent not in shared:
             shared.append(job_out.parent)
-        theta = theta_start_degC_of(canlog.read_log(job_log))
+        theta = theta_start_degC_of(canlog.read_log(job_log)) if theta_start_degC is None else theta_start_degC
         script.append(shlex.join(["bash", str(ROOT / "hil" / "replay_guest.sh"), str(Path(job_log).resolve()),
                                   str(job_out), "--frame-runs", str(frame_runs), "--timer-runs", str(timer_runs),
                                   "--tcu", str(tcu), "--calibration", calibration, *(["--bench"] if bench else []),
-                                  "--theta-start", f"{theta:.1f}",
+                                  *(["--shift", shift] if shift else []),
+                                  "--theta-start", f"{theta:.6g}",
                                   *(["--calibration-image", str(Path(calibration_image).resolve()), "--image-runs",
                                      str(image_runs)] if image_runs else [])]))
     rw = [arg for d in shared for arg in ("--rwdir", str(d))]
@@ -122,6 +128,54 @@ def run_on_vcan(jobs, frame_runs: int = 2, timer_runs: int = 1, tcu: Path | None
     if result.returncode != 0:
         raise RuntimeError(f"replay on vcan failed (exit {result.returncode}); see the messages above and"
                            f" the wc_tcu logs (*.txt) in {', '.join(str(o) for _, o in jobs)}")
+
+
+def wc_replay_program() -> Path:
+    """The in-process loop (src/host/wc_replay), release build first."""
+    for build in ("host-release", "host-debug"):
+        path = ROOT / "build" / build / "src" / "host" / "wc_replay"
+        if path.is_file():
+            return path
+    raise FileNotFoundError("wc_replay not built (cmake --preset host-release && cmake --build --preset host-release)")
+
+
+def run_in_process(jobs, frame_runs: int = 2, calibration: str = "table1", bench: bool = True) -> None:
+    """What run_on_vcan's frame-clock runs write (frame<n>.log: the inputs the TCU receives and its output
+    frames; frame<n>.json: its counters), from the same loop in-process (wc_replay): the HIL report without a
+    kernel or a guest. No timer-clock run (there is no time in-process). Raises on failure."""
+    program = wc_replay_program()
+    for job_log, job_out in jobs:
+        job_out = Path(job_out)
+        job_out.mkdir(parents=True, exist_ok=True)
+        messages = canlog.read_log(job_log)
+        theta = theta_start_degC_of(messages)
+        for i in range(1, frame_runs + 1):
+            stats = job_out / f"frame{i}.json"
+            run = subprocess.run([str(program), str(job_log), "--calibration", calibration,
+                                  "--theta-start", f"{theta:.6g}", "--stats-json", str(stats),
+                                  *(["--bench"] if bench else [])], capture_output=True, text=True)
+            if run.returncode != 0:
+                raise RuntimeError(f"wc_replay failed on {job_log} (exit {run.returncode}): {run.stderr.strip()}")
+            # the bus as a recording on vcan holds it: the replayed frames, then the TCU's of each step
+            outputs = canlog.read_log_lines(run.stdout.splitlines(), f"wc_replay {job_log}")
+            canlog.write_log(job_out / f"frame{i}.log", _interleave(messages, outputs))
+        for stale in job_out.glob("timer*.*"):   # a timer run of an earlier vcan replay is not this run's
+            stale.unlink()
+
+
+def _interleave(inputs, outputs) -> list:
+    """(timestamp, message) of the inputs and each step's outputs after the frame that stepped it (wc_replay
+    stamps its outputs with that frame's timestamp)."""
+    by_time: dict[float, list] = {}
+    for m in outputs:
+        by_time.setdefault(round(m.timestamp, 6), []).append(m)
+    sensors_id = canlog.database().get_message_by_name(canlog.SENSORS).frame_id
+    out = []
+    for m in inputs:
+        out.append((m.timestamp, m))
+        if m.arbitration_id == sensors_id and not (m.is_extended_id or m.is_remote_frame):
+            out += [(m.timestamp, o) for o in by_time.pop(round(m.timestamp, 6), [])]
+    return out
 
 
 # --------------------------------------------------------------------------- reference of the loop

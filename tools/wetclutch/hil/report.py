@@ -2,7 +2,8 @@
 
 Inputs: the bench log that was replayed (its BenchMeasurement frames carry the
 measured force, torque and clutch temperature) and what replay_guest.sh
-captured (frame-clock runs frame1/frame2, timer-clock run timer1).
+recorded (frame-clock runs frame1/frame2, timer-clock run timer1), or what
+replay.run_in_process wrote (frame1/frame2 from wc_replay, no timer run).
 """
 from __future__ import annotations
 
@@ -16,6 +17,9 @@ from . import replay
 from ..reference import model
 from ..util import atomic, canlog, mdf, plotting
 from ..calibration import Calibration
+
+ON_VCAN = "wc_tcu on vcan0 (frame clock in lockstep with its answers; timer clock at the log's pace)"
+IN_PROCESS = "the frame loop in-process (wc_replay: the same wc_loop_iterate as wc_tcu --clock frame)"
 
 PAPER = {  # Shin & Choi, section 3.5 and Fig. 15
     "steady_rmse_Nm": {750: 2.25, 250: 2.98, 500: 3.03},
@@ -268,6 +272,8 @@ def summary(m: dict, name: str) -> str:
     lines = [
         f"# HIL replay: {name}",
         "",
+        f"Ran on {m.get('ran_on', ON_VCAN)}.",
+        "",
         "| figure | this replay | paper | target |",
         "|---|---|---|---|",
         f"| steady-state torque RMSE | {m['torque_rmse_steady_Nm']:.2f} Nm | {m['torque_rmse_steady_paper_Nm']} Nm |"
@@ -315,7 +321,7 @@ def summary(m: dict, name: str) -> str:
     return "\n".join(lines)
 
 
-def analyse(cal: Calibration, log: Path, run_dir: Path, reference_check: bool = True) -> dict:
+def analyse(cal: Calibration, log: Path, run_dir: Path, reference_check: bool = True, where: str = ON_VCAN) -> dict:
     """Metrics, plots and summary.md for one replayed log; returns the metrics."""
     capture1 = canlog.read_log(run_dir / "frame1.log")
     capture2 = canlog.read_log(run_dir / "frame2.log") if (run_dir / "frame2.log").exists() else None
@@ -331,11 +337,12 @@ def analyse(cal: Calibration, log: Path, run_dir: Path, reference_check: bool = 
     m = metrics(cal, s, stats, stats_timer, deterministic, len(payloads), check)
     m["theta_start_degC"] = replay.theta_start_degC_of(canlog.read_log(log))
     m["log"] = str(log)
+    m["ran_on"] = where
     log_check = replay.check_log(log)
     m["log_problems"] = log_check.problems()
     with atomic.Staged() as out:   # the plots, the MDF4 capture, metrics.json and summary.md: all or none
         m["plots"] = plots(cal, s, m, run_dir)
-        written = mdf.write(run_dir / MDF_NAME, capture1, f"{Path(log).name} replayed to wc_tcu, frame clock run 1"
+        written = mdf.write(run_dir / MDF_NAME, capture1, f"{Path(log).name} replayed to {where}, frame clock run 1"
                                                           f" ({run_dir / 'frame1.log'})")
         m["mdf"] = {"path": written["path"], "groups": written["groups"], "left_out": mdf.skipped_text(written)}
         out.write_text(run_dir / "metrics.json", json.dumps(m, indent=2, default=float) + "\n")

@@ -107,24 +107,30 @@ def read_log(path: Path) -> list[can.Message]:
     path = Path(path)
     if not path.is_file():
         raise LogError(f"{path}: {'not a file' if path.exists() else 'no such log file'}")
-    messages = []
     try:
         with open(path, encoding="utf-8") as f:
-            for line_no, line in enumerate(f, start=1):
-                if not line.strip():
-                    continue
-                try:
-                    msg = next(iter(can.CanutilsLogReader([line])))
-                except (StopIteration, ValueError, IndexError) as e:
-                    raise LogError(f"{path}: line {line_no}: not a candump -L line: {line.strip()[:80]!r} ({e})") \
-                        from None
-                if not np.isfinite(msg.timestamp):
-                    raise LogError(f"{path}: line {line_no}: timestamp {msg.timestamp} is not finite")
-                messages.append(msg)
+            return read_log_lines(f, str(path))
     except UnicodeDecodeError:
         raise LogError(f"{path}: not UTF-8 text: not a candump -L log") from None
     except OSError as e:
         raise LogError(f"{path}: cannot read: {e.strerror}") from None
+
+
+def read_log_lines(lines, what: str) -> list[can.Message]:
+    """The messages of candump -L lines (a file, or a program's output split into lines); what names them
+    in the error of a malformed line."""
+    messages = []
+    for line_no, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            msg = next(iter(can.CanutilsLogReader([line])))
+        except (StopIteration, ValueError, IndexError) as e:
+            raise LogError(f"{what}: line {line_no}: not a candump -L line: {line.strip()[:80]!r} ({e})") \
+                from None
+        if not np.isfinite(msg.timestamp):
+            raise LogError(f"{what}: line {line_no}: timestamp {msg.timestamp} is not finite")
+        messages.append(msg)
     return messages
 
 
