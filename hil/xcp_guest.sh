@@ -1,46 +1,60 @@
 #!/usr/bin/env bash
 # A calibration tool's XCP session against wc_tcu on a live SocketCAN interface (DESIGN 13), where the
 # interface exists (natively, or inside the guest of hil/vcan_run.sh):
-#   bash hil/xcp_guest.sh DIR [--iface vcan0] [--tcu PATH] [--daq-seconds S]
-# DIR holds input.log (the TCU's inputs, played in a loop by canplayer), cal.img (the calibration image
-# wc_tcu starts from) and plan.json (the A2L's addresses and the image's bytes there,
-# tools/wetclutch/hil/xcp_session.py). While wc_tcu --xcp runs (frame clock) and candump captures
-# ClutchSensors, VfsCommand and the XCP frames, pyxcp runs the session (hil/xcp_master.py). Output in DIR: result.json (the session), capture.log,
-# stats.json and tcu.txt (wc_tcu), session.txt (the master's messages). Exits with the session's code.
+#   bash hil/xcp_guest.sh DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]
+# DIR holds input.log (the TCU's inputs), cal.img (the calibration image wc_tcu starts from) and plan.json
+# (the A2L's addresses and the image's bytes there, tools/wetclutch/hil/xcp_session.py). wc_tcu --xcp runs
+# with the frame clock; wc_canplay plays input.log in a loop, each period once the TCU's VfsCommand for the
+# last one is on the bus, never faster than the log and, during DAQ, never more than a few hundred steps
+# ahead of the master's decoding (DESIGN 5: a slower guest makes the session slower, never different),
+# and records ClutchSensors, VfsCommand and the XCP frames; pyxcp runs the session
+# (hil/xcp_master.py), waiting on the TCU's steps, never on the clock. Output in DIR: result.json (the
+# session), capture.log, stats.json and tcu.txt (wc_tcu), play.txt (wc_canplay), session.txt (the master's
+# messages). Exits with the session's code.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 die() { echo "xcp_guest: $*" >&2; exit 2; }
-[ $# -ge 1 ] || die "usage: $0 DIR [--iface vcan0] [--tcu PATH] [--daq-seconds S]"
+[ $# -ge 1 ] || die "usage: $0 DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]"
 dir=$(cd "$1" && pwd) || die "no directory $1"; shift
-iface=vcan0 tcu="$repo/build/host-release/src/port/wc_tcu" daq_seconds=5
+iface=vcan0 tcu="$repo/build/host-release/src/port/wc_tcu" daq_samples=5000
 while [ $# -gt 0 ]; do
   case $1 in
     --iface) iface=$2; shift 2 ;;
     --tcu) tcu=$2; shift 2 ;;
-    --daq-seconds) daq_seconds=$2; shift 2 ;;
+    --daq-samples) daq_samples=$2; shift 2 ;;
     *) die "unknown option '$1'" ;;
   esac
 done
+player=$(dirname "$tcu")/wc_canplay
 for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
-[ -x "$tcu" ] || die "TCU program $tcu not built (cmake --preset host-release && cmake --build --preset host-release)"
-# Socket buffers: the master's Python may fall seconds behind 8 DAQ frames a millisecond on an emulated
-# CPU; the frames wait in its socket instead of being dropped (where the system permits it).
+for program in "$tcu" "$player"; do
+  [ -x "$program" ] || die "$program not built (cmake --preset host-release && cmake --build --preset host-release)"
+done
+# Socket buffers: the master's Python may fall behind 8 DAQ frames a step on an emulated CPU; the frames
+# wait in its socket instead of being dropped (where the system permits it).
 sysctl -q -w net.core.rmem_max=67108864 net.core.rmem_default=67108864 2>/dev/null || true
 cd "$dir"
-. "$repo/hil/capture.sh"
-capture_start capture.log "$iface,110:7FF,120:7FF,7F0:7FE"   # ClutchSensors, VfsCommand, XCP
-"$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 --idle-exit 1 \
+# the master's flow control of the inputs during DAQ, on the guest's own tmpfs (a FIFO over 9p is not one)
+fifo_dir=$(mktemp -d /dev/shm/xcp.XXXXXX 2>/dev/null || mktemp -d)
+trap 'rm -rf "$fifo_dir"' EXIT
+mkfifo "$fifo_dir/limit"
+"$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 \
   --stats-json stats.json 2> tcu.txt &
 tcu_pid=$!
-sleep 0.3
-canplayer -l i -I input.log "$iface=$iface" &
+while kill -0 "$tcu_pid" 2>/dev/null && ! grep -q "clock frame" tcu.txt; do sleep 0.05; done
+grep -q "clock frame" tcu.txt || { cat tcu.txt >&2; die "wc_tcu did not start"; }
+"$player" input.log --iface "$iface" --loops 0 --pace log --limit-fifo "$fifo_dir/limit" --stop-pid "$tcu_pid" \
+  --record capture.log \
+  --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1 2> play.txt &
 play=$!
 rc=0
 "$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" \
-  --daq-seconds "$daq_seconds" > session.txt 2>&1 || rc=$?
-kill "$play" 2>/dev/null; wait "$play" 2>/dev/null
+  --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" > session.txt 2>&1 || rc=$?
+kill -TERM "$play" 2>/dev/null   # the player stops, then stops wc_tcu and records its last frames
+play_rc=0; wait "$play" || play_rc=$?
 tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?
+cat play.txt >&2
+if [ "$play_rc" -ne 0 ]; then echo "xcp_guest: wc_canplay failed (exit $play_rc), see $dir/play.txt" >&2; [ "$rc" -ne 0 ] || rc=$play_rc; fi
 if [ "$tcu_rc" -ne 0 ]; then echo "xcp_guest: wc_tcu failed (exit $tcu_rc), see $dir/tcu.txt" >&2; [ "$rc" -ne 0 ] || rc=$tcu_rc; fi
-capture_stop 600
 [ "$rc" -eq 0 ] || echo "xcp_guest: the XCP session failed (exit $rc), see $dir/session.txt" >&2
 exit "$rc"

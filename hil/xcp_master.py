@@ -2,7 +2,7 @@
 """The XCP master's side of a calibration session against ``wc_tcu --xcp`` (DESIGN 13), run where the
 SocketCAN interface is (natively, or inside the QEMU guest of hil/vcan_run.sh) by hil/xcp_guest.sh:
 
-    python hil/xcp_master.py --plan PLAN.json --out RESULT.json [--iface vcan0] [--daq-seconds 5]
+    python hil/xcp_master.py --plan PLAN.json --out RESULT.json [--iface vcan0] [--daq-samples 5000]
 
 The master is pyxcp over python-can, nobody's code here. PLAN.json is written on the host by
 tools/wetclutch/hil/xcp_session.py: the A2L's addresses as pya2ldb reads them and the bytes the calibration
@@ -11,11 +11,15 @@ emulated CPU every import costs seconds. It records what it saw in RESULT.json (
 fails); tests/python/test_xcp_session.py checks it with the bus capture. The session: connect, identity,
 checksum of the calibration page, every characteristic read back at its A2L address, a new holding margin
 downloaded, an invalid one refused, DAQ of 8 signals at the control step's 1 ms event, error packets for
-out-of-region and malformed commands, a DAQ overload, disconnect, and raw frames no master would send."""
+out-of-region and malformed commands, a DAQ overload, disconnect, and raw frames no master would send.
+Every wait is on the TCU's steps (its loop_steps counter, its VfsCommand frames) or on a sample count, never
+on the clock: the inputs come in lockstep with the TCU (hil/xcp_guest.sh), so a slower guest makes the
+session slower, never different (DESIGN 5)."""
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import struct
 import sys
 import time
@@ -28,7 +32,9 @@ sys.modules.setdefault("pandas", None)
 
 import can  # noqa: E402
 
-XCP_COMMAND_ID, XCP_RESPONSE_ID = 0x7F0, 0x7F1   # hil/wetclutch.dbc
+XCP_COMMAND_ID, XCP_RESPONSE_ID, VFS_COMMAND_ID = 0x7F0, 0x7F1, 0x120   # hil/wetclutch.dbc
+DAQ_WINDOW_STEPS = 200  # flow control: the inputs may run this many steps ahead of the last decoded DAQ sample
+WAIT_LIMIT_S = 600.0    # a wait for the TCU's steps that takes longer: it stopped stepping (a failure, said so)
 DAQ_SIGNALS = ("current_mA", "pressure_model_Pa", "force_command_N", "contact_force_N", "theta_degC",
                "model_torque_Nm", "slip_rad_s", "torque_request_Nm")
 
@@ -75,6 +81,15 @@ def _f32(xcp, address: int) -> float:
     return struct.unpack("<f", bytes(xcp.shortUpload(4, address)))[0]
 
 
+def _wait_steps(xcp, meas: dict, steps: int) -> None:
+    """Until the TCU's loop_steps counter has advanced by steps (each upload is answered between two steps)."""
+    address = meas["loop_steps"][0]
+    start, end = _u32(xcp, address), time.monotonic() + WAIT_LIMIT_S
+    while (_u32(xcp, address) - start) % (1 << 32) < steps:
+        if time.monotonic() > end:
+            raise TimeoutError(f"the TCU made fewer than {steps} steps in {WAIT_LIMIT_S} s: are its inputs played?")
+
+
 def _error_code(call) -> int | None:
     """The XCP error code a command is answered with, None when it succeeds."""
     from pyxcp.types import XcpResponseError
@@ -85,18 +100,28 @@ def _error_code(call) -> int | None:
     return None
 
 
-def _raw(bus: can.BusABC, data: bytes, wait_s: float = 0.2, **kw) -> list[bytes]:
-    """Send one raw frame on the XCP command id and collect the slave's answers for wait_s."""
+def _raw(bus: can.BusABC, data: bytes, steps: int = 3, **kw) -> list[bytes]:
+    """Send one raw frame on the XCP command id and collect the slave's answers until the TCU has sent
+    steps VfsCommands after it. wc_tcu answers a command in the iteration that receives it, and the frames
+    queued before it hold at most one step: by the third VfsCommand every answer is on the bus."""
+    while bus.recv(0) is not None:   # what came before this command is not its answer
+        pass
     bus.send(can.Message(arbitration_id=XCP_COMMAND_ID, data=data, is_extended_id=False, **kw))
-    got, end = [], time.monotonic() + wait_s
-    while time.monotonic() < end:
-        m = bus.recv(0.02)
-        if m is not None and m.arbitration_id == XCP_RESPONSE_ID and not m.is_extended_id:
+    got, seen, end = [], 0, time.monotonic() + WAIT_LIMIT_S
+    while seen < steps:
+        m = bus.recv(1.0)
+        if time.monotonic() > end:
+            raise TimeoutError(f"the TCU sent fewer than {steps} VfsCommands in {WAIT_LIMIT_S} s")
+        if m is None or m.is_extended_id:
+            continue
+        if m.arbitration_id == XCP_RESPONSE_ID:
             got.append(bytes(m.data))
+        elif m.arbitration_id == VFS_COMMAND_ID:
+            seen += 1
     return got
 
 
-def run_session(plan: dict, iface: str, daq_seconds: float, result: dict) -> dict:
+def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fifo: str | None = None) -> dict:
     """Fills result as it goes (a failure leaves what was seen before it)."""
     chars, meas = plan["characteristics"], plan["measurements"]
     cal_base, cal_size = plan["segments"]["calibration"]
@@ -126,30 +151,30 @@ def run_session(plan: dict, iface: str, daq_seconds: float, result: dict) -> dic
         result["characteristic_mismatches"] = mismatches
         result["holding_margin_read"] = _f32(xcp, margin_address)
         # a new holding margin: downloaded, the whole page checked, used from the next control step
-        time.sleep(0.3)
+        _wait_steps(xcp, meas, 20)   # the capture's old current: the page in use for a few steps
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 0.5))
-        time.sleep(0.3)
+        _wait_steps(xcp, meas, 20)
         result["after_download"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                     "accepted": _u32(xcp, meas["xcp_pages_accepted"][0]),
                                     "margin": _f32(xcp, margin_address)}
         # above its limit: written into the page, the page refused, the loop keeps the last good one
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 5.0))
-        time.sleep(0.3)
+        _wait_steps(xcp, meas, 20)
         result["after_invalid"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                    "page_error": _u32(xcp, meas["xcp_page_error"][0]),
                                    "rejected": _u32(xcp, meas["xcp_pages_rejected"][0]),
                                    "margin_in_page": _f32(xcp, margin_address)}
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 0.5))      # the page valid again (the margin in use)
-        time.sleep(0.3)
+        _wait_steps(xcp, meas, 20)
         result["after_restore"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                    "accepted": _u32(xcp, meas["xcp_pages_accepted"][0])}
         # DAQ of 8 signals at the control step's event (no command beside it: on an emulated CPU pyxcp's
         # Python cannot answer commands while it decodes 8 frames a millisecond)
-        with _Daq(xcp, meas) as daq:
-            daq.run_until(daq_seconds)
+        with _Daq(xcp, meas, limit_fifo) as daq:
+            daq.run_until(daq_samples)
         result["daq"] = daq.summary()
         # malformed and out-of-region commands: error packets, nothing else
         result["errors"] = {
@@ -170,7 +195,8 @@ def run_session(plan: dict, iface: str, daq_seconds: float, result: dict) -> dic
     result["disconnected"] = True
     # frames pyxcp would never send, on a socket of our own (pyxcp's would queue their answers as its own)
     with can.Bus(interface="socketcan", channel=iface,
-                 can_filters=[{"can_id": XCP_RESPONSE_ID, "can_mask": 0x7FF}]) as bus:
+                 can_filters=[{"can_id": XCP_RESPONSE_ID, "can_mask": 0x7FF},
+                              {"can_id": VFS_COMMAND_ID, "can_mask": 0x7FF}]) as bus:   # _raw counts the steps
         raw = {"before_connect": _raw(bus, bytes([0xFD]))}   # GET_STATUS while disconnected: no answer
         raw["connect"] = _raw(bus, bytes([0xFF, 0x00]))
         for name, data in (("unknown_command", bytes([0xC9])), ("short_set_mta", bytes([0xF6, 0, 0])),
@@ -186,9 +212,13 @@ def run_session(plan: dict, iface: str, daq_seconds: float, result: dict) -> dic
 
 class _Daq:
     """One DAQ list of DAQ_SIGNALS at event 0 (the control step), set up and started
-    by pyxcp's DaqProcessor; the samples (slave timestamp, values) as its policy receives them."""
+    by pyxcp's DaqProcessor; the samples (slave timestamp, values) as its policy receives them. With
+    limit_fifo (wc_canplay --limit-fifo), the inputs are held DAQ_WINDOW_STEPS ahead of the last decoded
+    sample: a master slower than the TCU holds the TCU's steps instead of losing frames or its answers
+    queueing behind seconds of samples (DESIGN 5)."""
 
-    def __init__(self, xcp, meas: dict):
+    def __init__(self, xcp, meas: dict, limit_fifo: str | None = None):
+        self.limit_fifo, self.limit = limit_fifo, None
         from pyxcp.daq_stim import DaqList
         self.xcp, self.meas = xcp, meas
         self.names = list(DAQ_SIGNALS)
@@ -198,19 +228,40 @@ class _Daq:
         xcp.transport.policy = self.policy
         self.policy.xcp_master = xcp
 
+    def _hold_at(self, step: int | None) -> None:
+        """The last step the inputs may reach (mod 65536, the DAQ timestamp's range), None: no limit."""
+        if self.limit is not None:
+            os.write(self.limit, b"none\n" if step is None else f"{step & 0xFFFF}\n".encode())
+
     def __enter__(self):
+        if self.limit_fifo:   # held from here (commands are answered without steps), until DAQ runs
+            self.limit = os.open(self.limit_fifo, os.O_WRONLY)   # blocks until the player has it open
+            self._hold_at(_u32(self.xcp, self.meas["loop_steps"][0]) + DAQ_WINDOW_STEPS)
         self.misses_before = _u32(self.xcp, self.meas["loop_deadline_misses"][0])
         self.policy.setup()
         self.policy.start()
+        # the first sample comes no earlier than the step after this one: sample i is at step >= this + i + 1,
+        # so a limit of this + i + 1 + window is never behind the samples the TCU has sent (no deadlock)
+        self.steps_at_start = _u32(self.xcp, self.meas["loop_steps"][0])
         self.started = time.monotonic()
         return self
 
-    def run_until(self, seconds: float) -> None:
-        time.sleep(max(0.0, seconds + 0.2 - (time.monotonic() - self.started)))   # + START/STOP's few steps
+    def run_until(self, samples: int) -> None:
+        """Until pyxcp has decoded samples samples (its receive thread appends them)."""
+        end, held = time.monotonic() + WAIT_LIMIT_S, None
+        while (decoded := len(self.samples.rows)) < samples:
+            if time.monotonic() > end:
+                raise TimeoutError(f"{decoded} DAQ samples of {samples} in {WAIT_LIMIT_S} s")
+            if decoded != held:   # the inputs at most DAQ_WINDOW_STEPS ahead of what is decoded
+                self._hold_at(self.steps_at_start + decoded + DAQ_WINDOW_STEPS)
+                held = decoded
+            time.sleep(0.02)
 
     def __exit__(self, *exc):
         self.policy.stop()
-        time.sleep(0.1)
+        self._hold_at(None)
+        if self.limit is not None:
+            os.close(self.limit)
         self.misses = _u32(self.xcp, self.meas["loop_deadline_misses"][0]) - self.misses_before
         return False
 
@@ -243,7 +294,7 @@ def _overload(xcp, meas: dict) -> dict:
     xcp.setDaqListMode(0x10, 0, 0, 1, 0)
     xcp.startStopDaqList(0x02, 0)
     xcp.startStopSynch(0x01)
-    time.sleep(0.2)
+    _wait_steps(xcp, meas, 50)
     xcp.startStopSynch(0x00)
     return {"odts": odts, "overloads": _u32(xcp, meas["xcp_daq_overloads"][0]) - before}
 
@@ -253,11 +304,12 @@ def main(argv=None) -> int:
     p.add_argument("--plan", required=True, help="the session's plan (tools/wetclutch/hil/xcp_session.py)")
     p.add_argument("--out", required=True)
     p.add_argument("--iface", default="vcan0")
-    p.add_argument("--daq-seconds", type=float, default=5.0)
+    p.add_argument("--daq-samples", type=int, default=5000, help="DAQ samples to collect (one a control step)")
+    p.add_argument("--limit-fifo", help="the input player's flow control (wc_canplay --limit-fifo)")
     args = p.parse_args(argv)
     result: dict = {}
     try:
-        run_session(json.loads(Path(args.plan).read_text()), args.iface, args.daq_seconds, result)
+        run_session(json.loads(Path(args.plan).read_text()), args.iface, args.daq_samples, result, args.limit_fifo)
     except Exception as e:   # the session's record says where it stopped; the test shows it
         result["failed"] = f"{type(e).__name__}: {e}"
         raise

@@ -25,12 +25,18 @@
  *                   only these ids (repeatable; default all)
  *   --stop-pid PID  at the end SIGTERM to PID (the TCU) and record until it
  *                   has exited, so its last frames are in the record
+ *   --limit-fifo PATH  flow control by a consumer of the TCU's output (the XCP
+ *                   master decoding DAQ): each line written to the FIFO is the
+ *                   last period the player may step, modulo 65536 (the XCP DAQ
+ *                   timestamp's range: one tick a step), or "none"; a consumer
+ *                   that falls behind holds the inputs instead of losing frames
  * Prints the periods played and the answers' wait (max, total) on stderr.
  * Exit 0; 1 no answer within --answer-timeout (default 120 s; a stuck or
  * crashed TCU), a send or receive failed; 2 usage, an unreadable or malformed
  * log. Host program (stdio and heap allowed). */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <fcntl.h>
 #include <linux/can.h>
 #include <linux/can/raw.h>
 #include <net/if.h>
@@ -67,6 +73,7 @@ typedef struct {
     uint32_t record_ids[MAX_RECORD_IDS];
     size_t record_id_count;
     long stop_pid;            /* 0: none */
+    const char *limit_fifo;   /* NULL: no flow control */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -88,6 +95,7 @@ static void usage(FILE *out)
 {
     fprintf(out, "usage: wc_canplay LOG [--iface vcan0] [--pace answer|log] [--answer-id ID|none] [--loops N]\n"
                  "                  [--answer-timeout S] [--record FILE [--record-id ID]...] [--stop-pid PID]\n"
+                 "                  [--limit-fifo PATH]\n"
                  "  (the header of src/port/wc_canplay.c says what each does)\n");
 }
 
@@ -238,6 +246,8 @@ static int parse_options(int argc, char **argv, options_t *o)
                 fprintf(stderr, "wc_canplay: --answer-timeout: '%s' is not a number of seconds in (0, 86400]\n", v);
                 return -1;
             }
+        } else if (strcmp(a, "--limit-fifo") == 0) {
+            o->limit_fifo = v;
         } else if (strcmp(a, "--record") == 0) {
             o->record_path = v;
         } else if (strcmp(a, "--stop-pid") == 0) {
@@ -311,6 +321,11 @@ typedef struct {
     FILE *record;
     const options_t *opt;
     unsigned long long answers;
+    int limit_fd;             /* --limit-fifo, -1: none */
+    bool limited;
+    uint16_t limit;           /* the last period it may step, modulo 65536 */
+    char limit_line[32];
+    size_t limit_len;
 } player_t;
 
 static void record_frame(player_t *p, const struct can_frame *f)
@@ -363,6 +378,57 @@ static int receive(player_t *p, double timeout_s)
     }
     return 0;
 }
+
+/* The lines the consumer wrote since the last call: the last one counts. Returns 0, or -1 on a bad line. */
+static int read_limit(player_t *p)
+{
+    char buf[256];
+    ssize_t n;
+    while ((n = read(p->limit_fd, buf, sizeof buf)) > 0) {
+        for (ssize_t i = 0; i < n; ++i) {
+            if (buf[i] != '\n') {
+                if (p->limit_len + 1u >= sizeof p->limit_line) { p->limit_len = 0; return -1; }
+                p->limit_line[p->limit_len++] = buf[i];
+                continue;
+            }
+            p->limit_line[p->limit_len] = '\0';
+            p->limit_len = 0;
+            char *end = NULL;
+            const unsigned long v = strtoul(p->limit_line, &end, 10);
+            if (strcmp(p->limit_line, "none") == 0) {
+                p->limited = false;
+            } else if ((end != p->limit_line) && (*end == '\0') && (v <= 65535u)) {
+                p->limited = true;
+                p->limit = (uint16_t)v;
+            } else {
+                fprintf(stderr, "wc_canplay: --limit-fifo: '%s' is neither a period (0..65535) nor 'none'\n",
+                        p->limit_line);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Whether period next is past the consumer's limit (a signed 16-bit difference: the two stay close). */
+static bool held(const player_t *p, unsigned long long next)
+{
+    return p->limited && ((int16_t)(uint16_t)(p->limit - (uint16_t)next) < 0);
+}
+
+/* Waits until period next may go (the consumer raised its limit); returns 0, or -1. */
+static int await_limit(player_t *p, unsigned long long next)
+{
+    for (;;) {
+        if (read_limit(p) != 0) { return -1; }
+        if (!held(p, next) || stop_requested) { return 0; }
+        struct pollfd both[2] = { { .fd = p->limit_fd, .events = POLLIN, .revents = 0 },
+                                  { .fd = p->fd, .events = POLLIN, .revents = 0 } };
+        if ((poll(both, 2, 100) < 0) && (errno != EINTR)) { return -1; }
+        if (((both[1].revents & POLLIN) != 0) && (receive(p, -1.0) != 0)) { return -1; }
+    }
+}
+
 
 static int send_frame(player_t *p, const struct can_frame *f)
 {
@@ -431,7 +497,16 @@ int main(int argc, char **argv)
     sa.sa_handler = on_signal;
     (void)sigaction(SIGINT, &sa, NULL);
     (void)sigaction(SIGTERM, &sa, NULL);
-    player_t p = { .fd = -1, .record = NULL, .opt = &opt, .answers = 0u };
+    player_t p = { .fd = -1, .record = NULL, .opt = &opt, .answers = 0u, .limit_fd = -1, .limited = false,
+                   .limit = 0u, .limit_line = { 0 }, .limit_len = 0u };
+    if (opt.limit_fifo != NULL) {  /* read-write: no end of file while the consumer has not opened it yet */
+        p.limit_fd = open(opt.limit_fifo, O_RDWR | O_NONBLOCK);
+        if (p.limit_fd < 0) {
+            fprintf(stderr, "wc_canplay: --limit-fifo %s: %s (make it with mkfifo)\n", opt.limit_fifo, strerror(errno));
+            free(frames);
+            return 2;
+        }
+    }
     if (opt.record_path != NULL) {
         p.record = fopen(opt.record_path, "w");
         if (p.record == NULL) {
@@ -457,8 +532,9 @@ int main(int argc, char **argv)
                     if (rc != 0) { break; }
                 }
             }
-            if ((rc == 0) && (send_frame(&p, f) != 0)) { rc = 1; }
             const bool steps = (f->can_id == WC_CAN_CLUTCH_SENSORS_FRAME_ID);  /* standard, not remote */
+            if ((rc == 0) && steps && (p.limit_fd >= 0) && (await_limit(&p, periods + 1u) != 0)) { rc = 1; }
+            if ((rc == 0) && !stop_requested && (send_frame(&p, f) != 0)) { rc = 1; }
             if ((rc == 0) && steps && (opt.answer_id >= 0)) {
                 const double waited_s = await_answers(&p, ++periods);
                 if (waited_s < 0.0) { rc = 1; break; }
@@ -479,6 +555,7 @@ int main(int argc, char **argv)
         rc = 1;
     }
     if (p.fd >= 0) { (void)close(p.fd); }
+    if (p.limit_fd >= 0) { (void)close(p.limit_fd); }
     free(frames);
     return rc;
 }

@@ -54,7 +54,7 @@ def tcu() -> Path:
 SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner", "test_xcp_session",
                 "test_shift", "test_film_study", "test_identify", "test_replay_inproc", "test_adaptation_study",
                 "test_adaptation_reference", "test_whole_shift"}
-VCAN_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
+VCAN_MODULES = {"test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_xcp_session"}
 VCAN_TESTS = {"test_vcan_whole_shift_equals_in_process"}
 LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_whole_shift", "test_adaptation_study",

@@ -1,6 +1,9 @@
 """Integration on a real kernel's vcan: wc_tcu on vcan0 (natively, or in the
-QEMU guest that hil/vcan_run.sh boots), frames in with canplayer, out with
-candump -L, decoded with cantools and checked against the reference model.
+QEMU guest that hil/vcan_run.sh boots), frames in with wc_canplay (with the
+frame clock in lockstep with the TCU's answers, DESIGN 5), the bus recorded by
+it, decoded with cantools and checked against the reference model; and a
+bundled bench log replayed frame-identical to the same loop in-process
+(wc_replay).
 
 The input log is an engagement with faults injected on purpose: one TorqueRequest
 with a bad CRC, one short TorqueRequest, one frame of an unknown id, and a
@@ -105,6 +108,23 @@ def test_tcu_counts_frames_and_rejects(replayed):
     assert stats["request_timeouts"] == 1 and stats["sensor_timeouts"] == 0
     assert stats["rx_dropped_by_kernel"] == 0 and stats["tx_errors"] == 0
     assert stats["steps"] == STEPS and stats["frames_out"] == 2 * STEPS
+
+
+BUNDLED = "engagement_750rpm"
+
+
+def test_bundled_log_on_vcan_is_frame_identical_to_wc_replay(tmp_path, root, tcu):
+    """The bundled 750 rpm engagement with its bench input: every frame wc_tcu sends on vcan (VfsCommand,
+    ClutchEstimate), byte for byte and in order, is the frame the same loop sends in-process."""
+    log = root / "hil" / "logs" / f"{BUNDLED}.log"
+    replay.run_on_vcan([(log, tmp_path / "vcan")], frame_runs=1, timer_runs=0, tcu=tcu, calibration="table1")
+    on_vcan = replay.raw_payloads(canlog.read_log(tmp_path / "vcan" / "frame1.log"))
+    replay.run_in_process([(log, tmp_path / "inproc")], frame_runs=1, calibration="table1")
+    in_process = replay.raw_payloads(canlog.read_log(tmp_path / "inproc" / "frame1.log"))
+    assert len(on_vcan) == 2 * 2500
+    assert on_vcan == in_process
+    stats = json.loads((tmp_path / "vcan" / "frame1.json").read_text())
+    assert stats["rx_dropped_by_kernel"] == 0 and stats["steps"] == 2500
 
 
 def test_timer_clock_runs_and_reports_step_times(replayed):

@@ -2,10 +2,9 @@
 is set down and up while wc_tcu runs. The TCU must keep running, say so
 (stderr, bus_errors in its statistics, StatusBusError), reopen its socket, stay
 in the safe state while its inputs resynchronise, and control again once they
-are back (DESIGN.md section 8, issue 10 item 7). The frame clock, so that the
-emulated guest's stalls (tens of ms) do not starve the steps: with the timer
-clock a stalled guest overflows the receive ring, and the lost frames keep the
-inputs out of sequence (the fail-safe reaction, but not this test's subject)."""
+are back (DESIGN.md section 8, issue 10 item 7). The frame clock, with the
+inputs played by wc_canplay in lockstep with the TCU's answers, and every wait
+on an event: a slower guest only makes it slower (DESIGN 5)."""
 from __future__ import annotations
 
 import json
@@ -25,24 +24,20 @@ pytestmark = needs_vcan
 
 GUEST = r"""
 set -u
-out=$1; tcu=$2
-. "$3"   # hil/capture.sh: candump on the guest's tmpfs (over 9p it lags the bus and misses frames under load)
-capture_start "$out/capture.log" vcan0
+out=$1; tcu=$2; player=$(dirname "$tcu")/wc_canplay
+# every wait is on an event (a line of wc_tcu's, an answer on the bus), never on the clock (DESIGN 5)
+until_said() { while kill -0 "$tcu_pid" 2>/dev/null && ! grep -q "$1" "$out/tcu.txt"; do sleep 0.05; done; }
 "$tcu" --iface vcan0 --clock frame --calibration table1 --stats-json "$out/stats.json" 2> "$out/tcu.txt" & tcu_pid=$!
-sleep 0.5
-canplayer -I "$out/before.log" vcan0=vcan0
+until_said "clock frame"
+"$player" "$out/before.log" --record "$out/capture.log" 2> "$out/play_before.txt" || echo "player failed" >> "$out/guest.txt"
 ip link set vcan0 down
-capture_stop 8   # candump (can-utils 2020.11) ends when its interface goes down: a second capture after it
-sleep 0.5
+until_said "interface down"
 ip link set vcan0 up
-capture_start "$out/capture_after.log" vcan0
-sleep 1.0        # candump bound before the first frame (0.3 s was too short in a loaded guest: it missed it)
-canplayer -I "$out/after.log" vcan0=vcan0
-sleep 0.5
+until_said "reopened"
+"$player" "$out/after.log" --record "$out/capture_after.log" 2> "$out/play_after.txt" || echo "player failed" >> "$out/guest.txt"
 # markers in their own file: wc_tcu's stderr (tcu.txt) has its own file offset
 kill -0 "$tcu_pid" && echo "wc_tcu still running" >> "$out/guest.txt"
 kill -TERM "$tcu_pid"; wait "$tcu_pid"; echo "wc_tcu exit $?" >> "$out/guest.txt"
-capture_stop
 """
 
 
@@ -60,11 +55,12 @@ def test_interface_down_and_up(tmp_path, tcu):
     out.mkdir()
     _logs(out)
     run = subprocess.run(["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out), "--",
-                          "bash", "-c", GUEST, "guest", str(out), str(tcu), str(ROOT / "hil" / "capture.sh")],
+                          "bash", "-c", GUEST, "guest", str(out), str(tcu)],
                          cwd=ROOT, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=900)
     text = (out / "tcu.txt").read_text()
     guest = (out / "guest.txt").read_text() if (out / "guest.txt").exists() else ""
     assert run.returncode == 0, run.stderr[-2000:] + text
+    assert "player failed" not in guest, guest + (out / "play_before.txt").read_text() + (out / "play_after.txt").read_text()
     assert "wc_tcu still running" in guest, guest + text    # it did not exit when the interface went down
     assert "wc_tcu exit 0" in guest, guest + text          # and stopped cleanly on SIGTERM
     # No sends while no frames arrive (frame clock): the receive sees ENETDOWN.

@@ -170,8 +170,9 @@ def test_vehicle_driveline_reaches_the_firmware():
 
 @needs_vcan
 def test_vcan_whole_shift_equals_in_process(tmp_path):
-    """One whole shift (both clutches, the engine request) against wc_tcu on vcan (natively or in the QEMU
-    guest) gives exactly the frames of the same case with the frame loop in-process."""
+    """One whole shift (both clutches, the engine request): the closed loop's inputs replayed to wc_tcu on vcan
+    (natively or in the QEMU guest) in lockstep give exactly the frames of the same case with the frame loop
+    in-process, run here again (so wc_tcu would have driven the plant to the same inputs: runner.run_on_vcan)."""
     path = shift.run_on_vcan(tmp_path, f"shift_1_2_{whole.FULL}", shift.NOMINAL, whole.plant_path("nominal"))
     vcan = json.loads(path.read_text())
     params = plant.load_plant(whole.plant_path("nominal"))

@@ -40,10 +40,10 @@ def write_plan(a2l: Path, image: Path, out: Path) -> dict:
     return plan
 
 
-def run_on_vcan(work: Path, tcu: Path, daq_seconds: float = 5.0) -> int:
+def run_on_vcan(work: Path, tcu: Path, daq_samples: int = 5000) -> int:
     """hil/xcp_guest.sh on work (input.log, cal.img, plan.json) on vcan: natively, in the serving guest
     (VCAN_SERVER) or in a guest of its own. Returns its exit code."""
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(work), "--", "bash",
-           str(ROOT / "hil" / "xcp_guest.sh"), str(work), "--tcu", str(tcu), "--daq-seconds", str(daq_seconds)]
+           str(ROOT / "hil" / "xcp_guest.sh"), str(work), "--tcu", str(tcu), "--daq-samples", str(daq_samples)]
     return subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL).returncode

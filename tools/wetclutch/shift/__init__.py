@@ -4,14 +4,12 @@ Lockstep on the frame clock: each period the plant's VCU/sensor side sends
 TorqueRequest (Mode 3, Shift), ShiftCommand and ClutchSensors (last: it steps
 the loop), the TCU answers VfsCommand, ClutchEstimate and, in the step a shift
 ends, ShiftReport; the plant then advances one period with that VFS current.
-Two TCUs run the same firmware code:
-
-  InprocTcu  `wc_replay --lockstep --shift NAME` through a pipe (the frame loop
-             linked into a host program): fast, for the scenario matrix;
-  VcanTcu    `wc_tcu --clock frame --shift NAME` on a SocketCAN interface
-             (python-can), natively or in the QEMU guest (hil/vcan_run.sh; runner.run_on_vcan).
-
-For the same case both give the same output frames (tests/python/test_whole_shift.py, the whole shift).
+The TCU is InprocTcu: `wc_replay --lockstep --shift NAME` through a pipe (the
+frame loop linked into a host program). runner.run_on_vcan replays a case's
+inputs to `wc_tcu --clock frame --shift NAME` on a SocketCAN interface
+(natively or in the QEMU guest, hil/vcan_run.sh) in lockstep with its answers:
+for the same case both give the same output frames
+(tests/python/test_whole_shift.py, the whole shift).
 
 Controllers compared (issue 13), variants of tools/calibrations/shift_1_2.toml:
 (a) feedback: PI only; (b) blind: 2-DOF, clutch temperature = oil; (c) full:
@@ -48,9 +46,9 @@ Quality per shift, from the plant's truth (DESIGN 10):
 One module per concern, every name importable from here (``shift.run_case``, ``shift.report``):
 
 scenarios   paths, thresholds, ShiftError, the scenario matrix
-tcu         InprocTcu (wc_replay --lockstep), VcanTcu (wc_tcu on SocketCAN)
+tcu         InprocTcu (wc_replay --lockstep)
 runner      one shift and a scenario's shifts (run_case), their frames (record_messages), reference_run,
-            run_on_vcan (guest: __main__.py)
+            run_on_vcan (the case's inputs replayed to wc_tcu on vcan)
 quality     the quality vector of a shift, a scenario's worst
 comparison  the matrix x controllers, the feedback gains' search, the targets, the report (and its MDF4 files)
 plots       the Fig. 4-style panels of a scenario (plot_case; plot_whole_case: both clutches and the engine)
@@ -67,12 +65,12 @@ from .runner import frame_sequence, record_messages, reference_run, run_case, ru
 from .scenarios import (ABORT_NAMES, CONTROLLERS, FLARE_RPM, JERK_CUTOFF_HZ, NOMINAL, ROOT, SHIFT_TOML, SOAK_SHIFTS,
                         SYNC_BAND_RAD_S, TARGET_INERTIA_S, TCU_CALIBRATION, TIE_UP_FRACTION, WC_REPLAY, Scenario,
                         ShiftError, scenario_matrix)
-from .tcu import InprocTcu, VcanTcu
+from .tcu import InprocTcu
 
 __all__ = [
     "ABORT_NAMES", "CONTROLLERS", "FEEDBACK_KI", "FEEDBACK_KP", "FLARE_RPM", "INERTIA_TOLERANCE", "JERK_CUTOFF_HZ",
     "JERK_LIMIT_M_S3", "NOMINAL", "PRESSURE_RATIO_TARGET", "ROOT", "SHIFT_TOML", "SOAK_SHIFTS", "SYNC_BAND_RAD_S",
     "TARGET_INERTIA_S", "TCU_CALIBRATION", "TIE_UP_FRACTION", "WC_REPLAY", "InprocTcu", "Scenario", "ShiftError",
-    "VcanTcu", "frame_sequence", "markdown", "plot_case", "quality", "record_messages", "reference_run", "report",
+    "frame_sequence", "markdown", "plot_case", "quality", "record_messages", "reference_run", "report",
     "run_case", "run_matrix", "run_on_vcan", "scenario_matrix", "targets", "tune_feedback", "worst",
 ]

@@ -5,8 +5,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import os
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +14,9 @@ from ..reference import shift as shift_reference
 from ..simulate import plant as plant_mod
 from ..util import canlog
 from .quality import quality
-from .scenarios import FAULTS, NOMINAL, ROOT, SHIFT_TOML, TARGET_INERTIA_S, Scenario, ShiftError, scenario_matrix
-from .tcu import InprocTcu, VcanTcu
+from .scenarios import (FAULTS, NOMINAL, SHIFT_TOML, TARGET_INERTIA_S, TCU_CALIBRATION, Scenario, ShiftError,
+                        scenario_matrix)
+from .tcu import InprocTcu
 
 
 def frame_sequence(records: list[dict]) -> list[tuple[int, str]]:
@@ -25,41 +24,34 @@ def frame_sequence(records: list[dict]) -> list[tuple[int, str]]:
     return [(fid, data) for rec in records for _, fid, data in rec["frames"]]
 
 
-# ``python -m wetclutch.shift`` without python-can's MF4 support: it imports asammdf and pandas when they are
-# installed (the tool's MDF4 output needs them), which the guest does not use and which cost about a minute
-# of imports on its emulated CPU (the vcan shift test: 65 s before asammdf was installed, 139 s after).
-_GUEST_MAIN = ("import runpy, sys; sys.modules['asammdf'] = None; sys.modules['pandas'] = None; "
-               "runpy.run_module('wetclutch.shift', run_name='__main__')")
-
-
 def run_on_vcan(out_dir: Path, shift_name: str = "shift_1_2_full", scenario_name: str = NOMINAL,
                 plant_path=plant_mod.DEFAULT_PLANT) -> Path:
-    """One closed-loop shift against wc_tcu on vcan0 (natively or in the QEMU guest, hil/vcan_run.sh);
-    writes out_dir/vcan_frames.json and returns its path."""
+    """One closed-loop shift on vcan0 (natively or in the QEMU guest, hil/vcan_run.sh). The case runs in closed
+    loop with the frame loop in-process (InprocTcu); the frames the TCU received there, period by period, go to
+    wc_tcu --shift on vcan0 in lockstep with its answers (wc_canplay, hil/replay_guest.sh), the bus recorded.
+    If wc_tcu on vcan answers these inputs with exactly the in-process frames, the plant would have received
+    the same commands in a closed loop over vcan, so it would have sent the same inputs: the same case, with
+    nothing but the TCU and the player in the guest (the plant in the guest's Python took 350 s on a slow
+    host). Writes out_dir/vcan_frames.json ({"frames": what wc_tcu sent on vcan, (id, hex) in order,
+    "inproc_frames": the in-process case's, "quality": the in-process case's}) and returns its path."""
+    from ..hil import replay
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
-    cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(out_dir), "--",
-           str(ROOT / ".venv" / "bin" / "python"), "-c", _GUEST_MAIN, "--vcan-guest", str(out_dir),
-           shift_name, scenario_name, str(plant_path)]
-    env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
-    result = subprocess.run(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL)
-    if result.returncode != 0:
-        raise ShiftError(f"closed-loop shift on vcan failed (exit {result.returncode}); see {out_dir}")
-    return out_dir / "vcan_frames.json"
-
-
-def _vcan_guest(out_dir: str, shift_name: str, scenario_name: str, plant_path: str) -> int:
-    """Guest side of run_on_vcan: the case against wc_tcu on vcan0, frames and quality to JSON."""
     sc = next(s for s in scenario_matrix() if s.name == scenario_name)
-    params = plant_mod.load_plant(plant_path)
-    tcu = VcanTcu(shift_name, sc.oil_degC, log_dir=Path(out_dir))
-    try:
-        recs = run_case(params, shift_name, sc, tcu=tcu)
-    finally:
-        tcu.close()
-    payload = {"frames": frame_sequence(recs), "quality": [quality(r) for r in recs]}
-    Path(out_dir, "vcan_frames.json").write_text(json.dumps(payload, default=float))
-    return 0
+    if sc.shifts != 1:
+        raise ShiftError(f"scenario {scenario_name}: {sc.shifts} shifts; run_on_vcan replays one")
+    recs = run_case(plant_mod.load_plant(plant_path), shift_name, sc)
+    inputs = [(rec["t0_s"] + rec["t_s"][k], canlog.can.Message(arbitration_id=fid, data=data, is_extended_id=False))
+              for rec in recs for k, frames in enumerate(rec["frames_in"]) for fid, data in frames]
+    canlog.write_log(out_dir / "inputs.log", inputs)
+    replay.run_on_vcan([(out_dir / "inputs.log", out_dir / "vcan")], frame_runs=1, timer_runs=0,
+                       calibration=TCU_CALIBRATION, bench=False, shift=shift_name, theta_start_degC=sc.oil_degC)
+    sent_ids = {m.arbitration_id for _, m in inputs}
+    frames = [(m.arbitration_id, bytes(m.data).hex().upper()) for m in canlog.read_log(out_dir / "vcan" / "frame1.log")
+              if m.arbitration_id not in sent_ids]
+    payload = {"frames": frames, "inproc_frames": frame_sequence(recs), "quality": [quality(r) for r in recs]}
+    (out_dir / "vcan_frames.json").write_text(json.dumps(payload, default=float))
+    return out_dir / "vcan_frames.json"
 
 
 def _fault_injector(fault: str, k_torque: int, k_inertia: int, dt: float, then=None):

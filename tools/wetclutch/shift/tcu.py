@@ -1,5 +1,5 @@
-"""The two TCUs a closed-loop shift runs against, the same firmware code: the frame loop in-process
-(InprocTcu, wc_replay --lockstep) and the TCU program on a SocketCAN interface (VcanTcu, wc_tcu)."""
+"""The TCU a closed-loop shift runs against: the frame loop in-process (InprocTcu, wc_replay --lockstep), the
+same firmware code as wc_tcu on vcan (runner.run_on_vcan replays a case's inputs to it)."""
 from __future__ import annotations
 
 import subprocess
@@ -82,65 +82,3 @@ class InprocTcu:
         self.proc.wait(timeout=10)
         self.proc.stdout.close()
         self.proc.stderr.close()
-
-
-class VcanTcu:
-    """The TCU program on a SocketCAN interface: wc_tcu --clock frame --shift NAME, frames through python-can.
-    Each exchange sends the period's frames and returns what the TCU sent up to its ClutchEstimate (with the
-    whole shift: up to its EngineTorqueRequest); a ShiftReport, sent after them, comes with the next exchange:
-    the frame sequence is the same as in-process."""
-
-    def __init__(self, shift_name: str, theta_start_degC: float, overrides: dict | None = None,
-                 calibration: str = TCU_CALIBRATION, iface: str = "vcan0", log_dir: Path | None = None):
-        import can
-        if overrides:
-            raise ShiftError("wc_tcu takes compiled-in shift calibrations only (no overrides)")
-        program = ROOT / "build" / "host-release" / "src" / "port" / "wc_tcu"
-        if not program.is_file():
-            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
-        db = canlog.database()
-        # the whole shift (DESIGN 14): OffgoingVfsCommand and EngineTorqueRequest close each step's cyclic frames
-        from ..calibration import shift as shift_calibration
-        variant = shift_calibration.load(SHIFT_TOML).variants.get(shift_name.split("shift_1_2_")[-1])
-        whole = variant is not None and int(variant.coordinator) == 1
-        names = (canlog.COMMAND, canlog.ESTIMATE, canlog.SHIFT_REPORT) + (
-            (canlog.OFFGOING_COMMAND, canlog.ENGINE_REQUEST) if whole else ())
-        self.ids = {db.get_message_by_name(n).frame_id for n in names}
-        self.estimate_id = db.get_message_by_name(canlog.ENGINE_REQUEST if whole else canlog.ESTIMATE).frame_id
-        self.bus = can.Bus(interface="socketcan", channel=iface,
-                           can_filters=[{"can_id": i, "can_mask": 0x7FF, "extended": False} for i in sorted(self.ids)])
-        self.log = Path(log_dir or ".") / "wc_tcu_shift.txt"
-        self.log_file = open(self.log, "w")
-        self.proc = subprocess.Popen([str(program), "--iface", iface, "--clock", "frame", "--calibration", calibration,
-                                      "--shift", shift_name, "--theta-start", f"{theta_start_degC:.6g}"],
-                                     stdout=subprocess.DEVNULL, stderr=self.log_file)
-        import time
-        for _ in range(200):
-            if "clock frame" in self.log.read_text() or self.proc.poll() is not None:
-                break
-            time.sleep(0.05)
-        if self.proc.poll() is not None or "clock frame" not in self.log.read_text():
-            raise ShiftError(f"wc_tcu did not start: {self.log.read_text().strip()}")
-
-    def exchange(self, t_s: float, frames) -> list[tuple[int, bytes]]:
-        for m in frames:
-            self.bus.send(m)
-        out = []
-        while True:
-            msg = self.bus.recv(timeout=10.0)
-            if msg is None:
-                raise ShiftError(f"no answer from wc_tcu at t = {t_s:.3f} s: {self.log.read_text().strip()[-400:]}")
-            if msg.arbitration_id not in self.ids or msg.is_error_frame:
-                continue
-            out.append((msg.arbitration_id, bytes(msg.data)))
-            if msg.arbitration_id == self.estimate_id:
-                return out
-
-    def close(self):
-        import signal
-        self.proc.send_signal(signal.SIGTERM)
-        try:
-            self.proc.wait(timeout=10)
-        finally:
-            self.bus.shutdown()
-            self.log_file.close()
