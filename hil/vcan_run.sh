@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Run a command with a SocketCAN interface (vcan0) up; see DESIGN.md section 5.
 #   bash hil/vcan_run.sh [--iface vcan0] [--rwdir DIR]... [--vm] -- CMD ARGS...
-#   bash hil/vcan_run.sh [--iface vcan0] --serve DIR      # one guest for many commands
+#   bash hil/vcan_run.sh [--iface vcan0] [--slow FACTOR] --serve DIR      # one guest for many commands
 # Native when the host kernel has vcan, otherwise inside a QEMU guest booted by
 # virtme-ng (vng) on the kernel image in /boot. The guest sees the host file
 # system read-only, except the repository, the working directory and each
@@ -14,15 +14,18 @@
 # exists. Such a command waits for its turn (the guest's CPU is not shared
 # between two replays), then behaves as with its own guest: its output, its exit
 # code. A --rwdir outside the repository and /tmp, or no server up: its own guest.
+# --slow FACTOR (with --serve, a QEMU guest): before the first command the guest is slowed to 1/FACTOR of
+# its speed by a CPU cgroup's quota, measured (hil/vcan_slow.sh; DIR/slow/factor says what was reached).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-iface=vcan0 force_vm=0 rwdirs=("$repo") serve=""
+iface=vcan0 force_vm=0 rwdirs=("$repo") serve="" slow=""
 die() { echo "vcan_run: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case $1 in
     --iface) [ $# -ge 2 ] || die "--iface needs a name"; iface=$2; shift 2 ;;
     --rwdir) [ -d "${2:-}" ] || die "--rwdir needs an existing directory"; rwdirs+=("$(cd "$2" && pwd)"); shift 2 ;;
     --vm) force_vm=1; shift ;;
+    --slow) [[ ${2:-} =~ ^[1-9][0-9]*$ ]] || die "--slow needs a whole factor (e.g. 3)"; slow=$2; force_vm=1; shift 2 ;;
     --serve) [ -n "${2:-}" ] || die "--serve needs a directory"; serve=$2; shift 2; break ;;
     --) shift; break ;;
     *) die "unknown option '$1'; usage: $0 [--iface vcan0] [--rwdir DIR]... [--vm] -- CMD ARGS..." ;;
@@ -116,7 +119,12 @@ if [ -n "$serve" ]; then  # the guest serves DIR's jobs; /tmp writable for the j
   vng_args+=(--rwdir /tmp)
   [[ $serve/ == /tmp/* || $serve/ == "$repo"/* ]] || vng_args+=(--rwdir "$serve")
   guest_cmd="bash $(printf %q "$repo/hil/vcan_guest.sh") --serve $(printf %q "$serve") $(printf %q "$iface")"
+  if [ -n "$slow" ]; then
+    . "$repo/hil/vcan_slow.sh"
+    slow_queue "$serve" || die "cannot queue the slowing job in $serve"
+  fi
 fi
+[ -z "$slow" ] || [ -n "$serve" ] || die "--slow goes with --serve"
 
 # stdin: /dev/null (no tty needed). stdout/stderr: through fifos, because QEMU
 # reopens /proc/self/fd/1 and 2 with O_TRUNC: a log file would be clobbered.
@@ -134,7 +142,12 @@ while kill -0 "$vng_pid" 2>/dev/null && [ ! -e "$booted" ]; do
 done
 [ -t 2 ] && printf '\n' >&2
 [ -e "$booted" ] && echo "vcan_run: guest up after $((SECONDS - start)) s, running: ${serve:+serving $serve}$*" >&2
+if [ -n "$slow" ]; then
+  if slow_apply "$serve" "$slow" "$vng_pid"; then echo "vcan_run: $(cat "$serve/slow/factor")" >&2
+  else echo "vcan_run: slowing the guest failed: $(cat "$serve/slow/factor" "$serve/slow/failed" 2>/dev/null)" >&2; fi
+fi
 vng_rc=0; wait "$vng_pid" || vng_rc=$?; vng_pid=; wait; cat_pids=
+if [ -n "$slow" ]; then slow_release; fi
 if [ -n "$serve" ]; then rm -f "$serve/serving"; finish "$vng_rc"; fi
 if [ -s "$state/rc" ]; then finish "$(cat "$state/rc")"; fi
 echo "vcan_run: the guest did not report an exit code (vng exit $vng_rc: QEMU failed to start," \

@@ -8,6 +8,9 @@
 #   bash scripts/test.sh --quick   # the edit-compile-test loop (under 3 min): static analysis,
 #                                  # ctest and the Python tests not marked slow (no vcan, HIL,
 #                                  # shift matrix, film study, identification, in-process replays)
+#   bash scripts/test.sh --slow-guest  # the vcan tests alone, in a QEMU guest slowed to a third of its
+#                                  # speed (hil/vcan_slow.sh: a CPU cgroup quota, the factor measured
+#                                  # and printed; fails when it is not reached): they must pass there too
 #
 # Both cores are used where that weakens nothing: two fuzzers side by side
 # (each on its own core for its full 60 s, so each gets the executions it gets
@@ -18,11 +21,12 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
 
-quick=0
+quick=0 slow_guest=0
 case "${1:-}" in
   "") ;;
   --quick) quick=1 ;;
-  *) echo "test: unknown option '$1' (usage: bash scripts/test.sh [--quick])" >&2; exit 2 ;;
+  --slow-guest) slow_guest=1 ;;
+  *) echo "test: unknown option '$1' (usage: bash scripts/test.sh [--quick|--slow-guest])" >&2; exit 2 ;;
 esac
 
 stage_names=()
@@ -71,7 +75,9 @@ checks() {  # one core's worth, run beside the third fuzzer (called in an || lis
 vcan_dir=""
 vcan_server_start() {  # one guest for every vcan test (hil/vcan_run.sh --serve), booting before pytest
   vcan_dir=$(mktemp -d /tmp/vcan_server.XXXXXX)
-  bash hil/vcan_run.sh --serve "$vcan_dir" >"$vcan_dir/log" 2>&1 &
+  local slow=()
+  [ "$slow_guest" = 0 ] || slow=(--slow 3)
+  bash hil/vcan_run.sh "${slow[@]}" --serve "$vcan_dir" >"$vcan_dir/log" 2>&1 &
   vcan_pid=$!
   export VCAN_SERVER=$vcan_dir
 }
@@ -82,8 +88,14 @@ vcan_server_stop() {
   kill "$vcan_pid" 2>/dev/null || true
   wait "$vcan_pid" 2>/dev/null || true
   echo "vcan: one guest ran $(find "$vcan_dir/jobs" -name rc 2>/dev/null | wc -l) vcan commands ($(tail -n 1 "$vcan_dir/log"))"
+  local slowed_ok=0
+  if [ "$slow_guest" = 1 ]; then
+    echo "vcan: $(cat "$vcan_dir/slow/factor" "$vcan_dir/slow/failed" 2>/dev/null)"
+    grep -q "^slowed" "$vcan_dir/slow/factor" 2>/dev/null && ! grep -q "NOT reached" "$vcan_dir/slow/factor" || slowed_ok=1
+  fi
   rm -rf "$vcan_dir"
   vcan_dir=""
+  return "$slowed_ok"
 }
 
 fuzz_and_checks() {  # the last fuzzer and the checks side by side; each prints whole when done
@@ -107,15 +119,21 @@ python_tests() {
   # (tests/python/conftest.py); the 15 slowest tests listed
   local args=(-n 2 --dist loadgroup --no-loadscope-reorder -ra --durations=15)
   [ "$quick" = 1 ] && args+=(-m "not slow")
+  [ "$slow_guest" = 1 ] && args=(-ra --durations=15 -m vcan)   # one guest: one worker
   [ "$quick" = 1 ] || [ -n "$vcan_dir" ] || vcan_server_start
   # pytest's own exit code, its output shown as it comes (and its summary kept for the end)
   local rc=0
   .venv/bin/python -m pytest tests/python "${args[@]}" | tee "$pytest_log" || rc=$?
-  vcan_server_stop
+  vcan_server_stop || { echo "test: the guest was not slowed as asked (above)" >&2; [ "$rc" -ne 0 ] || rc=1; }
   return "$rc"
 }
 
 stage "setup (scripts/setup.sh)" bash scripts/setup.sh
+if [ "$slow_guest" = 1 ]; then
+  stage "build: host-release" bash -c 'cmake --preset host-release >/dev/null && cmake --build --preset host-release'
+  stage "vcan tests in a guest slowed to a third (pytest -m vcan)" python_tests
+  exit 0
+fi
 stage "build: host-debug (address + undefined sanitizers)$([ "$quick" = 0 ] && echo ", host-release")" build
 if [ "$quick" = 1 ]; then
   stage "static analysis (cppcheck gating; MISRA C:2012 counts)" bash scripts/static_analysis.sh build/host-debug

@@ -57,7 +57,7 @@ SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faul
 VCAN_MODULES = {"test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_xcp_session"}
 VCAN_TESTS = {"test_vcan_whole_shift_equals_in_process"}
-LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_whole_shift", "test_adaptation_study",
+LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_whole_shift", "test_hil_replay", "test_adaptation_study",
                  "test_adaptation_reference",
                  "test_cli_output_faults", "test_replay_inproc", "test_lut", "test_cli_bad_input", "test_bench")
 
