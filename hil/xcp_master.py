@@ -103,16 +103,17 @@ def _error_code(call) -> int | None:
 def _raw(bus: can.BusABC, data: bytes, steps: int = 3, **kw) -> list[bytes]:
     """Send one raw frame on the XCP command id and collect the slave's answers until the TCU has sent
     steps VfsCommands after it. wc_tcu answers a command in the iteration that receives it, and the frames
-    queued before it hold at most one step: by the third VfsCommand every answer is on the bus."""
-    while bus.recv(0) is not None:   # what came before this command is not its answer
-        pass
+    queued before it hold at most one step: by the third VfsCommand every answer is on the bus. What the
+    socket received before the send (its kernel timestamp, the same clock as time.time()) is not counted:
+    a drain with recv(0) left frames behind in the emulated guest, and the count ended before the answer."""
+    sent = time.time()
     bus.send(can.Message(arbitration_id=XCP_COMMAND_ID, data=data, is_extended_id=False, **kw))
     got, seen, end = [], 0, time.monotonic() + WAIT_LIMIT_S
     while seen < steps:
         m = bus.recv(1.0)
         if time.monotonic() > end:
             raise TimeoutError(f"the TCU sent fewer than {steps} VfsCommands in {WAIT_LIMIT_S} s")
-        if m is None or m.is_extended_id:
+        if m is None or m.is_extended_id or m.timestamp < sent:
             continue
         if m.arbitration_id == XCP_RESPONSE_ID:
             got.append(bytes(m.data))
