@@ -24,7 +24,15 @@
  *           on-coming clutch's); the third ClutchSensors choice of the frame
  *           id below is then OffgoingSensors (E2E-valid and plausible like the
  *           other control frames, its own alive counter; raw bytes give SNA
- *           and out-of-range values); bits 1-7 unused.
+ *           and out-of-range values); bits 1-4 (with bit 0) the start: 0 at
+ *           wc_loop_init as above, k = 1..15 inside the whole shift, from the
+ *           snapshot start_points[(k - 1) % 10] ("Starts inside the whole
+ *           shift" below: idle in Shift mode, torque phase, inertia phase,
+ *           lock-up, locked, fallbacks) that a fixed scripted prefix left; the
+ *           loop's configuration and start temperature are then the
+ *           snapshot's (byte 0 bits 4-5 unused), a fuzzed loop configuration
+ *           (bit 6) is applied with wc_loop_recalibrate, and the clock,
+ *           "make valid" and "plausible" are the input's; bits 5-7 unused.
  *   then records until the bytes run out (at most MAX_RECORDS), each a
  *   command byte c:
  *     c & 3 == 0  a timer tick without a frame
@@ -139,14 +147,6 @@ static bool verbose;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-int LLVMFuzzerInitialize(int *argc, char ***argv)
-{
-    (void)argc;
-    (void)argv;
-    verbose = fz_env_flag("WC_FUZZ_VERBOSE");
-    return 0;
-}
 
 typedef struct {
     wc_loop_clock_t clock;
@@ -667,93 +667,337 @@ static void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsign
     if (xcp_on && ((n > 0u) || !xcp_waits)) { xcp_step(h, n > 0u, record); }
 }
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+/* The records of an input (see the top of the file) until the bytes run out or *record passes MAX_RECORDS. */
+static void run_records(harness_t *h, fz_reader_t *r, unsigned *record)
 {
-    fz_reader_t r;
-    fz_reader_init(&r, data, size);
-    harness_t h;
-    memset(&h, 0, sizeof h);
-    const uint8_t options = fz_u8(&r);
-    h.clock = ((options & 0x01u) != 0u) ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
-    h.make_valid = (options & 0x04u) != 0u;
-    h.plausible = (options & 0x08u) != 0u;
-    static const float starts[4] = { 40.0f, -40.0f, 250.0f, NAN };
-    const float theta_start = starts[(options >> 4) & 3u];
-    const wc_loop_config_t defaults = WC_LOOP_CONFIG_DEFAULT;
-    h.config = defaults;
-    if ((options & 0x40u) != 0u) {
-        h.config.sensor_timeout_periods = fz_u8(&r) % 32u;
-        h.config.request_timeout_periods = fz_u8(&r) % 32u;
-        h.config.e2e.max_delta_counter = fz_u8(&r) % 20u;
-        h.config.e2e.sync_counter = fz_u8(&r) % 8u;
-        h.config.recovery_periods = fz_u8(&r) % 64u;
-    }
-    h.shift = (options & 0x80u) != 0u;
-    h.config.bench_input_enabled = ((options & 0x02u) != 0u) && !h.shift;
-    h.config.shift = !h.shift ? NULL : (((options & 0x02u) != 0u) ? &wc_shift_1_2_adaptive : &wc_shift_1_2_full);
-    const uint8_t shift_options = h.shift ? fz_u8(&r) : 0u;
-    if ((shift_options & 0x01u) != 0u) {  /* the whole shift: the off-going clutch as the on-coming one */
-        h.config.shift = &wc_shift_1_2_whole_full;
-        h.config.offgoing = cal;
-    }
-    h.whole = wc_loop_whole_shift(&h.config);
-    if (h.whole) {
-        h.engine_increase_max_Nm = h.config.shift->engine_increase_max_Nm;
-        h.engine_reduction_max_Nm = h.config.shift->engine_reduction_max_Nm;
-    }
-
-    fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
-    fz_arg(theta_start);
-    fz_ctx.iargs[0] = options | (shift_options << 8);
-    fz_ctx.iargs[1] = (long)h.config.recovery_periods;
-    FZ_CHECK(wc_loop_init(&loop, cal, &h.config, theta_start) == WC_CAL_OK, "wc_loop_init failed");
-    FZ_CHECK(wc_loop_whole_shift(&loop.config) == h.whole, "the loop's whole shift %d, configured %d",
-             (int)wc_loop_whole_shift(&loop.config), (int)h.whole);
-    xcp_on = false;
-    xcp_tried = false;
-    xcp_frames = 0u;
-    xcp_checks = 0u;
-
-    for (unsigned record = 1u; (record <= MAX_RECORDS) && fz_more(&r); ++record) {
-        const uint8_t c = fz_u8(&r);
+    for (; (*record <= MAX_RECORDS) && fz_more(r); ++*record) {
+        const uint8_t c = fz_u8(r);
         switch (c & 3u) {
         case 0:
-            iterate(&h, NULL, true, record, false);
+            iterate(h, NULL, true, *record, false);
             break;
         case 1:
         case 2: {
             wc_can_frame_t f;
-            build_frame(&h, &r, c, &f);
-            const bool tick = ((c & 3u) == 2u) || ((h.clock == WC_LOOP_CLOCK_TIMER) && ((c & 0x04u) != 0u));
-            if ((f.id == WC_CAN_XCP_COMMAND_FRAME_ID) && xcp_start(&h)) {  /* as wc_tcu: the slave's, not the loop's */
+            build_frame(h, r, c, &f);
+            const bool tick = ((c & 3u) == 2u) || ((h->clock == WC_LOOP_CLOCK_TIMER) && ((c & 0x04u) != 0u));
+            if ((f.id == WC_CAN_XCP_COMMAND_FRAME_ID) && xcp_start(h)) {  /* as wc_tcu: the slave's, not the loop's */
                 (void)wc_xcp_receive(&xcp, &f);
-                iterate(&h, NULL, tick, record, false);
+                iterate(h, NULL, tick, *record, false);
             } else {
-                iterate(&h, &f, tick, record, false);
+                iterate(h, &f, tick, *record, false);
             }
             break;
         }
         default: {
-            if (((c & 0x10u) != 0u) && xcp_start(&h)) {  /* an XCP command frame */
+            if (((c & 0x10u) != 0u) && xcp_start(h)) {  /* an XCP command frame */
                 wc_can_frame_t f;
-                build_xcp_frame(&r, &f);
+                build_xcp_frame(r, &f);
                 (void)wc_xcp_receive(&xcp, &f);  /* a full ring is counted */
-                iterate(&h, NULL, (c & 0x20u) != 0u, record, (c & 0x40u) != 0u);
+                iterate(h, NULL, (c & 0x20u) != 0u, *record, (c & 0x40u) != 0u);
                 break;
             }
-            const uint8_t count = fz_u8(&r);
-            fz_context("port event", record);
+            const uint8_t count = fz_u8(r);
+            fz_context("port event", *record);
             switch ((c >> 2) & 3u) {
             case 0: wc_loop_port_event(&loop, WC_LOOP_PORT_RX_DROPPED, count); break;
             case 1: wc_loop_port_event(&loop, WC_LOOP_PORT_BUS_ERROR, count); break;
             case 2: wc_loop_port_event(&loop, WC_LOOP_PORT_TX_FAILED, count); break;
             default: wc_loop_deadline_missed(&loop, count); break;
             }
-            check_counters(&h);
+            check_counters(h);
             break;
         }
         }
     }
+}
+
+/* The loop configuration bytes (options bit 6; see the top of the file) into h->config. */
+static void read_loop_config(harness_t *h, fz_reader_t *r)
+{
+    h->config.sensor_timeout_periods = fz_u8(r) % 32u;
+    h->config.request_timeout_periods = fz_u8(r) % 32u;
+    h->config.e2e.max_delta_counter = fz_u8(r) % 20u;
+    h->config.e2e.sync_counter = fz_u8(r) % 8u;
+    h->config.recovery_periods = fz_u8(r) % 64u;
+}
+
+/* The harness options of byte 0 that are not the loop's state (a start from a snapshot takes them too). */
+static void read_harness_options(harness_t *h, uint8_t options)
+{
+    h->clock = ((options & 0x01u) != 0u) ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
+    h->make_valid = (options & 0x04u) != 0u;
+    h->plausible = (options & 0x08u) != 0u;
+}
+
+/* The header of an input: byte 0 (*options), the loop configuration (bit 6), the shift-options byte (bit 7;
+ * else 0: *shift_options); into h (zeroed first). Returns the start temperature (bits 4-5). */
+static float read_header(harness_t *h, fz_reader_t *r, uint8_t *options_out, uint8_t *shift_options_out)
+{
+    memset(h, 0, sizeof *h);
+    const uint8_t options = fz_u8(r);
+    read_harness_options(h, options);
+    static const float starts[4] = { 40.0f, -40.0f, 250.0f, NAN };
+    const float theta_start_degC = starts[(options >> 4) & 3u];
+    const wc_loop_config_t defaults = WC_LOOP_CONFIG_DEFAULT;
+    h->config = defaults;
+    if ((options & 0x40u) != 0u) { read_loop_config(h, r); }
+    h->shift = (options & 0x80u) != 0u;
+    h->config.bench_input_enabled = ((options & 0x02u) != 0u) && !h->shift;
+    h->config.shift = !h->shift ? NULL : (((options & 0x02u) != 0u) ? &wc_shift_1_2_adaptive : &wc_shift_1_2_full);
+    const uint8_t shift_options = h->shift ? fz_u8(r) : 0u;
+    if ((shift_options & 0x01u) != 0u) {  /* the whole shift: the off-going clutch as the on-coming one */
+        h->config.shift = &wc_shift_1_2_whole_full;
+        h->config.offgoing = cal;
+    }
+    h->whole = wc_loop_whole_shift(&h->config);
+    if (h->whole) {
+        h->engine_increase_max_Nm = h->config.shift->engine_increase_max_Nm;
+        h->engine_reduction_max_Nm = h->config.shift->engine_reduction_max_Nm;
+    }
+    *options_out = options;
+    *shift_options_out = shift_options;
+    return theta_start_degC;
+}
+
+/* A fresh loop for the header read: wc_loop_init. */
+static void start_fresh(harness_t *h, uint8_t options, uint8_t shift_options, float theta_start_degC)
+{
+    fz_context("wc_loop_init(theta_start; options, recovery)", 0u);
+    fz_arg(theta_start_degC);
+    fz_ctx.iargs[0] = options | (shift_options << 8);
+    fz_ctx.iargs[1] = (long)h->config.recovery_periods;
+    FZ_CHECK(wc_loop_init(&loop, cal, &h->config, theta_start_degC) == WC_CAL_OK, "wc_loop_init failed");
+    FZ_CHECK(wc_loop_whole_shift(&loop.config) == h->whole, "the loop's whole shift %d, configured %d",
+             (int)wc_loop_whole_shift(&loop.config), (int)h->whole);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Starts inside the whole shift (shift-options bits 1-4)                   */
+/* ------------------------------------------------------------------------ */
+
+/* A whole shift needs hundreds of loop steps to reach its later phases (PREPARE 50 periods, TORQUE 220, INERTIA
+ * at least 200, LOCKUP 50, a fallback's finish 1000): an input that starts there at wc_loop_init is long and every
+ * execution of it pays for the phases before. Instead an input can start from a snapshot: the loop (and the
+ * harness's own state: its E2E senders' counters, the oracle's history) as a fixed scripted prefix left it. The
+ * prefixes are frame streams through the same records, iterate() and oracle as any input; they do not depend on
+ * fuzz bytes. They run once, in LLVMFuzzerInitialize; an input that starts from one costs a copy of the loop.
+ * wc_loop_t is caller-owned plain storage (no allocation, no state outside it): restored at the same address
+ * its pointers (the off-going view into the loop, the calibrations) are those of the run that made it.
+ *
+ * The scripts are those of make_seeds.py (SCRIPT_NOMINAL, the whole_shift seed's scenario, in the frames of its
+ * whole_periods: a 1->2 upshift at a constant output speed, ClutchSensors with the tick every 2nd 1 ms period and
+ * a bare tick between, OffgoingSensors every 4th, ShiftCommand and TorqueRequest in Shift mode every 10th), with
+ * byte 0 = 0xCC (shift control, loop configuration, plausible, make valid; timer clock, 40 degC), its
+ * WHOLE_CONFIG (timeouts 25, MaxDeltaCounter 2, SyncCounter 2, recovery 5) and the whole shift. A seed that
+ * starts from a snapshot continues the same script from its period; started at wc_loop_init with the script's
+ * periods before it, the same input gives the same loop state bit for bit. */
+#define W_O_RPM (3000.0 / 4.7)
+#define SLIP_12_RPM ((4.7 - 3.1) * W_O_RPM)
+#define INERTIA_MS 250.0
+static const uint8_t prefix_header[] = { 0x80u | 0x40u | 0x08u | 0x04u, 25u, 25u, 2u, 2u, 5u, 0x01u };
+
+enum { LOST_NONE = 0u, LOST_ALL = 1u };
+typedef struct {
+    uint32_t first;          /* periods first..last-1 */
+    uint32_t last;
+    uint8_t request;         /* ShiftCommand.ShiftRequest */
+    int32_t inertia_start;   /* the period the slip starts to fall (smoothstep over INERTIA_MS); < 0: not yet */
+    uint8_t lost;            /* LOST_ALL: no frame at all, a bare tick per period */
+} segment_t;
+
+typedef struct {
+    const char *name;
+    const segment_t *script;  /* ends with last == 0 */
+    uint32_t period;          /* the snapshot is taken before this period of the script */
+} start_point_t;
+
+/* make_seeds.py SCRIPT_NOMINAL: in Shift mode, the request edge at 30, the slip falls from 300, withdrawn at 640. */
+static const segment_t script_nominal[] = {
+    { 0u, 30u, 0u, -1, LOST_NONE }, { 30u, 300u, 1u, -1, LOST_NONE }, { 300u, 640u, 1u, 300, LOST_NONE },
+    { 640u, 660u, 0u, 300, LOST_NONE }, { 0u, 0u, 0u, 0, 0u } };
+/* Every input lost in the inertia phase (the sensors time out after 25 periods): finished on the model, released
+ * after fallback_time_s (1 s). */
+static const segment_t script_lost_inertia[] = {
+    { 0u, 30u, 0u, -1, LOST_NONE }, { 30u, 300u, 1u, -1, LOST_NONE }, { 300u, 400u, 1u, 300, LOST_NONE },
+    { 400u, 1420u, 1u, 300, LOST_ALL }, { 0u, 0u, 0u, 0, 0u } };
+/* Every input lost in the torque phase: handed back. */
+static const segment_t script_lost_torque[] = {
+    { 0u, 30u, 0u, -1, LOST_NONE }, { 30u, 200u, 1u, -1, LOST_NONE }, { 200u, 300u, 1u, -1, LOST_ALL },
+    { 0u, 0u, 0u, 0, 0u } };
+
+/* shift-options bits 1-4: 0 wc_loop_init, k = 1..15 start_points[(k - 1) % N]. The phases are those the table1
+ * calibration and wc_shift_1_2_whole_full give (WC_FUZZ_VERBOSE=1 prints them); make_seeds.py START has the same table. */
+static const start_point_t start_points[] = {
+    { "idle in Shift mode, inputs fresh (the request edge next)", script_nominal, 30u },
+    { "torque phase, its start", script_nominal, 90u },
+    { "torque phase, 20 ms before its end", script_nominal, 280u },
+    { "inertia phase, the off-going clutch's hand-over", script_nominal, 305u },
+    { "inertia phase, its middle", script_nominal, 430u },
+    { "lock-up hand-over", script_nominal, 560u },
+    { "locked (the request withdrawn at 640)", script_nominal, 620u },
+    { "inputs lost 30 periods ago in the inertia phase (fallback finish)", script_lost_inertia, 430u },
+    { "fallback finish, 25 periods before its end (released)", script_lost_inertia, 1390u },
+    { "inputs lost 30 periods ago in the torque phase (handed back)", script_lost_torque, 230u },
+};
+#define START_POINTS (sizeof start_points / sizeof start_points[0])
+
+typedef struct {
+    wc_loop_t loop;
+    harness_t h;
+} snapshot_t;
+static snapshot_t snapshots[START_POINTS];  /* 1.7 KiB each */
+
+static size_t put_u16_of(uint8_t *b, double x, double lo, double hi)
+{
+    /* make_seeds.py u16_of: round half to even (nearbyint in the default rounding mode), saturated */
+    double u = nearbyint((x - lo) / (hi - lo) * 65535.0);
+    u = (u < 0.0) ? 0.0 : ((u > 65535.0) ? 65535.0 : u);
+    const uint16_t v = (uint16_t)u;
+    b[0] = (uint8_t)(v & 0xFFu);
+    b[1] = (uint8_t)(v >> 8);
+    return 2u;
+}
+
+static double smoothstep(double x)
+{
+    x = (x < 0.0) ? 0.0 : ((x > 1.0) ? 1.0 : x);
+    return x * x * (3.0 - 2.0 * x);
+}
+
+/* The records of period k of a segment (make_seeds.py whole_periods, offgoing_every 4); returns their length. */
+static size_t script_period(const segment_t *s, uint32_t k, uint8_t *b)
+{
+    size_t n = 0u;
+    const double x = (s->inertia_start < 0) ? 0.0 : ((double)k - (double)s->inertia_start) / INERTIA_MS;
+    const double slip = SLIP_12_RPM * (1.0 - smoothstep(x));
+    const bool sent = s->lost == LOST_NONE;
+    if (sent && (k % 10u == 0u)) {
+        b[n++] = 1u | (6u << 3);  /* ShiftCommand: request, AdaptationReset 0, gear 2, 150 Nm, 250 ms */
+        b[n++] = 0u;
+        b[n++] = s->request;
+        b[n++] = 0u;
+        b[n++] = 1u;
+        n += put_u16_of(&b[n], 150.0, -1000.0, 1000.0);
+        n += put_u16_of(&b[n], INERTIA_MS, 50.0, 2000.0);
+        b[n++] = 1u | (3u << 3);  /* TorqueRequest: 0 Nm, Mode 3 (Shift) */
+        b[n++] = 0u;
+        n += put_u16_of(&b[n], 0.0, 0.0, 2000.0);
+        b[n++] = 3u;
+    }
+    if (sent && (k % 4u == 0u)) {
+        b[n++] = 1u | (2u << 3);  /* OffgoingSensors */
+        b[n++] = 0u;
+        n += put_u16_of(&b[n], slip - SLIP_12_RPM, -8000.0, 8000.0);
+    }
+    if (sent && (k % 2u == 0u)) {
+        b[n++] = 1u | 0x04u;  /* ClutchSensors with the tick: oil 80, housing 75 degC */
+        b[n++] = 0u;
+        n += put_u16_of(&b[n], slip, -8000.0, 8000.0);
+        n += put_u16_of(&b[n], 80.0, -40.0, 200.0);
+        n += put_u16_of(&b[n], 75.0, -40.0, 200.0);
+    } else {
+        b[n++] = 0u;  /* a bare tick */
+    }
+    return n;
+}
+
+/* Runs every script once and keeps the snapshots (LLVMFuzzerInitialize: before the first input). */
+static void make_snapshots(void)
+{
+    for (size_t i = 0u; i < START_POINTS; ++i) {
+        const start_point_t *p = &start_points[i];
+        if ((i > 0u) && (p->script == start_points[i - 1u].script) && (p->period >= start_points[i - 1u].period)) {
+            continue;  /* taken on the previous one's run */
+        }
+        harness_t h;
+        fz_reader_t r;
+        uint8_t options;
+        uint8_t shift_options;
+        fz_reader_init(&r, prefix_header, sizeof prefix_header);
+        const float theta_start_degC = read_header(&h, &r, &options, &shift_options);
+        start_fresh(&h, options, shift_options, theta_start_degC);
+        xcp_on = false;
+        xcp_tried = false;
+        size_t next = i;  /* the snapshots of this script, in period order */
+        for (const segment_t *s = p->script; s->last != 0u; ++s) {
+            for (uint32_t k = s->first; k < s->last; ++k) {
+                while ((next < START_POINTS) && (start_points[next].script == p->script) &&
+                       (start_points[next].period == k)) {
+                    FZ_CHECK(loop.rx_tail == loop.rx_head, "snapshot with frames in the ring");
+                    memcpy(&snapshots[next].loop, &loop, sizeof loop);
+                    snapshots[next].h = h;
+                    ++next;
+                }
+                uint8_t b[64];  /* a period's records: at most 31 bytes */
+                fz_reader_init(&r, b, script_period(s, k, b));
+                unsigned record = 1u;
+                run_records(&h, &r, &record);
+            }
+        }
+        FZ_CHECK((next == START_POINTS) || (start_points[next].script != p->script),
+                 "start point %u after its script's end", (unsigned)next);
+    }
+    if (verbose) {
+        for (size_t i = 0u; i < START_POINTS; ++i) {
+            const wc_loop_t *l = &snapshots[i].loop;
+            fprintf(stderr, "fuzz_loop: start %u: %s: period %u, phase %u (%u periods), fallback %u, safe %d, "
+                            "second gear %d, off-going released %d\n",
+                    (unsigned)(i + 1u), start_points[i].name, (unsigned)start_points[i].period, (unsigned)l->shift.phase,
+                    (unsigned)l->shift.phase_periods, (unsigned)l->shift.fallback,
+                    (int)(l->fresh_periods < l->config.recovery_periods), (int)l->shift.second_gear,
+                    (int)l->shift.offgoing_released);
+        }
+    }
+}
+
+int LLVMFuzzerInitialize(int *argc, char ***argv)
+{
+    (void)argc;
+    (void)argv;
+    verbose = fz_env_flag("WC_FUZZ_VERBOSE");
+    make_snapshots();
+    return 0;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_reader_t r;
+    fz_reader_init(&r, data, size);
+    harness_t h;
+    uint8_t options;
+    uint8_t shift_options;
+    const float theta_start_degC = read_header(&h, &r, &options, &shift_options);
+    const uint32_t start = ((shift_options & 0x01u) != 0u) ? ((shift_options >> 1) & 0x0Fu) : 0u;
+    if (start == 0u) {
+        start_fresh(&h, options, shift_options, theta_start_degC);
+    } else {
+        /* a start inside the whole shift: the snapshot's loop and harness state (its configuration and start
+         * temperature); byte 0's clock, "make valid" and "plausible" apply from here on, and a fuzzed loop
+         * configuration (bit 6: timeouts, E2E, recovery) through wc_loop_recalibrate, as an XCP page would */
+        const snapshot_t *s = &snapshots[(start - 1u) % START_POINTS];
+        const wc_loop_config_t fuzzed = h.config;
+        memcpy(&loop, &s->loop, sizeof loop);
+        h = s->h;
+        read_harness_options(&h, options);
+        if ((options & 0x40u) != 0u) {
+            h.config.sensor_timeout_periods = fuzzed.sensor_timeout_periods;
+            h.config.request_timeout_periods = fuzzed.request_timeout_periods;
+            h.config.e2e = fuzzed.e2e;
+            h.config.recovery_periods = fuzzed.recovery_periods;
+            fz_context("wc_loop_recalibrate(the fuzzed loop configuration; start, recovery)", 0u);
+            fz_ctx.iargs[0] = (long)start;
+            fz_ctx.iargs[1] = (long)h.config.recovery_periods;
+            FZ_CHECK(wc_loop_recalibrate(&loop, cal, &h.config) == WC_CAL_OK, "wc_loop_recalibrate failed");
+        }
+    }
+    xcp_on = false;
+    xcp_tried = false;
+    xcp_frames = 0u;
+    xcp_checks = 0u;
+
+    unsigned record = 1u;
+    run_records(&h, &r, &record);
     iterate(&h, NULL, true, MAX_RECORDS + 1u, false);  /* empties the ring */
     FZ_CHECK(loop.rx_tail == loop.rx_head, "frames left in the ring after a step");
     if (verbose) {
@@ -768,9 +1012,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 (unsigned)loop.counters.rejected[WC_REJECT_IMPLAUSIBLE],
                 (unsigned)loop.counters.rejected[WC_REJECT_OVERFLOW], (unsigned)loop.counters.rejected[WC_REJECT_SYNC]);
         if (h.whole) {
-            fprintf(stderr, "fuzz_loop: whole shift: phase %u, fallback %u, engine intervention steps %u, safe steps "
-                            "with a fallback %u, sensor timeouts %u\n",
-                    (unsigned)loop.shift.phase, (unsigned)loop.shift.fallback, (unsigned)h.engine_steps,
+            fprintf(stderr, "fuzz_loop: whole shift (start %u): phase %u, fallback %u, engine intervention steps %u, "
+                            "safe steps with a fallback %u, sensor timeouts %u\n",
+                    (unsigned)start, (unsigned)loop.shift.phase, (unsigned)loop.shift.fallback, (unsigned)h.engine_steps,
                     (unsigned)h.fallback_steps, (unsigned)loop.counters.sensor_timeouts);
         }
         if (h.shift) {

@@ -3,7 +3,9 @@
 
     python3 tests/fuzz/make_seeds.py            # rewrites tests/fuzz/corpus/{model,loop,calibration}/
 
-Standard library only, deterministic (the committed seeds are its output).
+Standard library only, deterministic (the committed seeds are its output: a
+file in those folders that it no longer makes is removed).
+
 The byte formats are described at the top of each harness (fuzz_model.c,
 fuzz_loop.c, fuzz_calibration.c); the CAN frames follow hil/wetclutch.dbc
 (little-endian signals, CRC-8 SAE J1850 over the data id and bytes 1..7,
@@ -18,9 +20,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 CORPUS = HERE / "corpus"
 
 
-# --------------------------------------------------------------------------
 # shared: fz_float encodings (wc_fuzz_common.h)
-# --------------------------------------------------------------------------
 
 def f_raw(x):
     """tag 0: the float's raw bit pattern, whatever the argument's range."""
@@ -31,9 +31,7 @@ def f_bits(bits):
     return bytes([0]) + struct.pack("<I", bits)
 
 
-# --------------------------------------------------------------------------
 # model harness
-# --------------------------------------------------------------------------
 
 OP_TORQUE, OP_INVERSE, OP_THERMAL, OP_FRICTION, OP_VISCOSITY, OP_FILM, OP_HYDRAULICS, OP_STEP = range(8)
 MODE_OPEN, MODE_TORQUE, MODE_LOCKED = 0, 1, 2
@@ -100,9 +98,7 @@ def model_seeds():
     return seeds
 
 
-# --------------------------------------------------------------------------
 # loop harness
-# --------------------------------------------------------------------------
 
 ID_SENSORS, ID_REQUEST, ID_BENCH = 0x110, 0x111, 0x130
 SEL_SENSORS, SEL_REQUEST, SEL_BENCH, SEL_OTHER = 0, 3, 6, 7
@@ -373,35 +369,94 @@ def whole_periods(b, first, last, request, inertia_start=None, inertia_ms=250.0,
     return b
 
 
-def loop_whole_shift():
-    """'make valid' + 'plausible', the whole shift: Shift mode idle (the off-going clutch holds 1st gear), the
-    request edge, fill, torque phase, inertia phase, lock-up, locked (ShiftReport), request withdrawn."""
-    b = bytes([0x80 | 0x40 | 0x08 | 0x04]) + WHOLE_CONFIG + bytes([0x01])
-    b = whole_periods(b, 0, 30, 0)
-    b = whole_periods(b, 30, 300, 1)
-    b = whole_periods(b, 300, 640, 1, inertia_start=300)
-    b = whole_periods(b, 640, 660, 0, inertia_start=300)
+# Starts inside the whole shift (fuzz_loop.c, "Starts inside the whole shift"): shift-options bits 1-4 = k picks
+# the harness's snapshot k, which a scripted prefix left: the scenario of loop_whole_shift below (SCRIPT_NOMINAL,
+# in the frames of whole_periods), or the same with every input lost from period 400 (inertia phase: START
+# lost_inertia, fallback_end) or 200 (torque phase: handback). A seed that starts there continues the same script
+# from the snapshot's period. fuzz_loop.c start_points: the same table (the harness runs the prefixes).
+SCRIPT_NOMINAL = ((0, 30, 0, None), (30, 300, 1, None), (300, 640, 1, 300), (640, 660, 0, 300))
+START = {  # name: (k, the snapshot's script period)
+    "idle": (1, 30), "torque": (2, 90), "torque_end": (3, 280), "inertia": (4, 305), "inertia_mid": (5, 430),
+    "lockup": (6, 560), "locked": (7, 620), "lost_inertia": (8, 430), "fallback_end": (9, 1390), "handback": (10, 230),
+}
+LOST_ALL = ("shift", "request", "offgoing", "sensors")
+
+
+def whole_start(name):
+    """'make valid' + 'plausible' (the snapshot's configuration, no configuration bytes), the whole shift from
+    snapshot START[name]."""
+    return bytes([0x80 | 0x08 | 0x04, 0x01 | (START[name][0] << 1)])
+
+
+def nominal_periods(b, first, last, **kw):
+    """SCRIPT_NOMINAL's periods first..last-1 (whole_periods with the request and inertia start of each)."""
+    for seg_first, seg_last, request, inertia_start in SCRIPT_NOMINAL:
+        lo, hi = max(first, seg_first), min(last, seg_last)
+        if lo < hi:
+            b = whole_periods(b, lo, hi, request, inertia_start=inertia_start, **kw)
     return b
 
 
-def loop_whole_shift_faults():
-    """The whole shift's faults: OffgoingSensors with a wrong CRC, a repeated and a jumped counter, then lost in
-    the torque phase (safe state: handed back, the off-going clutch at its maximum current); back, a new request
-    edge, and OffgoingSensors lost again in the inertia phase (finished on the model), then back."""
+def loop_whole_shift():
+    """'make valid' + 'plausible', the whole shift from wc_loop_init: Shift mode idle (the off-going clutch holds
+    1st gear), the request edge, fill, torque phase, inertia phase, lock-up, locked (ShiftReport), request
+    withdrawn: SCRIPT_NOMINAL, the harness's prefix. With frames every 20 periods (bare ticks between; the
+    timeouts are 25): 1.5 KB instead of 4.6 KB with frames every 2nd period."""
     b = bytes([0x80 | 0x40 | 0x08 | 0x04]) + WHOLE_CONFIG + bytes([0x01])
-    b = whole_periods(b, 0, 30, 0)
-    b = whole_periods(b, 30, 120, 1)
+    for seg_first, seg_last, request, inertia_start in SCRIPT_NOMINAL:
+        for k in range(seg_first, seg_last):
+            x = 0.0 if inertia_start is None else (k - inertia_start) / 250.0
+            slip = SLIP_12_RPM * (1 - smoothstep(x))
+            if k % 20 == 0:
+                b += p_shift(request) + p_request() + p_offgoing(slip - SLIP_12_RPM) + p_sensors(slip)
+            else:
+                b += bytes([0])
+    return b
+
+
+def loop_whole_starts():
+    """Seeds from the snapshots, each through a part of the shift (at most ~150 periods, ~1 KB)."""
+    seeds = {}
+    # the request edge: fill pulse, prepare, into the torque phase
+    seeds["whole_start_idle"] = nominal_periods(whole_start("idle"), 30, 120)
+    # the torque phase, with OffgoingSensors faults: a wrong CRC, a repeated and a jumped counter, as fuzzed
+    b = nominal_periods(whole_start("torque"), 90, 120)
     b += p_offgoing(0.0, fault=2) + bytes([0x5A]) + bytes([0])       # CRC error
     b += p_offgoing(0.0, fault=1) + bytes([0]) + bytes([0])          # repeated counter
     b += p_offgoing(0.0, fault=1) + bytes([5]) + bytes([0])          # counter jump
     b += bytes([1 | (SEL_OFFGOING << 3) | (3 << 6), 0x00]) + bytes(8) + bytes([0])  # as fuzzed: all zero, CRC wrong
-    b = whole_periods(b, 124, 170, 1, lost=("offgoing",))            # lost: timeout, hand-back
-    b = whole_periods(b, 170, 200, 0)                                # back; the request withdrawn
-    b = whole_periods(b, 200, 460, 1)
-    b = whole_periods(b, 460, 470, 1, lost=("offgoing",))
-    b = whole_periods(b, 470, 540, 1, inertia_start=470, lost=("offgoing",))  # lost into the inertia phase
-    b = whole_periods(b, 540, 800, 1, inertia_start=470)
-    return b
+    seeds["whole_start_torque_faults"] = nominal_periods(b, 124, 200)
+    # OffgoingSensors lost in the torque phase: timeout, safe state, handed back (the off-going clutch at its
+    # maximum); back, the request withdrawn, a new edge
+    b = nominal_periods(whole_start("torque"), 90, 150, lost=("offgoing",))
+    b = whole_periods(b, 150, 180, 0)
+    seeds["whole_start_torque_lost"] = whole_periods(b, 180, 240, 1)
+    # the torque phase's end: the hand-over into the inertia phase (the off-going slip falls below -1 rad/s)
+    seeds["whole_start_torque_end"] = nominal_periods(whole_start("torque_end"), 280, 380)
+    # the inertia phase from its start: the off-going clutch's hand-over, the PI on the reference
+    seeds["whole_start_inertia"] = nominal_periods(whole_start("inertia"), 305, 440)
+    # OffgoingSensors lost as the inertia phase begins (README: released at once; finished on the model), back
+    b = nominal_periods(whole_start("inertia"), 305, 345, lost=("offgoing",))
+    seeds["whole_start_inertia_lost"] = nominal_periods(b, 345, 420)
+    # the inertia phase's second half: synchronous, into the lock-up hand-over
+    seeds["whole_start_inertia_mid"] = nominal_periods(whole_start("inertia_mid"), 430, 580)
+    # the lock-up hand-over, locked, the request withdrawn (IDLE, the off-going clutch back)
+    seeds["whole_start_lockup"] = nominal_periods(whole_start("lockup"), 560, 660)
+    # locked, then every input lost: the fallback finish in LOCKED
+    b = nominal_periods(whole_start("locked"), 620, 630)
+    seeds["whole_start_locked_lost"] = whole_periods(b, 630, 680, 1, inertia_start=300, lost=LOST_ALL)
+    # the fallback finish (inputs lost in the inertia phase): the inputs come back (E2E sync, recovery)
+    b = whole_periods(whole_start("lost_inertia"), 430, 440, 1, inertia_start=300, lost=LOST_ALL)
+    seeds["whole_start_finish_back"] = whole_periods(b, 440, 520, 1, inertia_start=300)
+    # the fallback finish's end: released after fallback_time_s, then the inputs back and the request withdrawn
+    b = whole_periods(whole_start("fallback_end"), 1390, 1430, 1, inertia_start=300, lost=LOST_ALL)
+    b = whole_periods(b, 1430, 1470, 1, inertia_start=300)
+    seeds["whole_start_released"] = whole_periods(b, 1470, 1500, 0, inertia_start=300)
+    # handed back (inputs lost in the torque phase): back, withdrawn, a new shift's edge
+    b = whole_periods(whole_start("handback"), 230, 260, 1)
+    b = whole_periods(b, 260, 290, 0)
+    seeds["whole_start_handback"] = whole_periods(b, 290, 400, 1)
+    return seeds
 
 
 def raw_offgoing(slip_raw):
@@ -435,7 +490,7 @@ def loop_seeds():
     return {
         **xcp_seeds(),
         "whole_shift": loop_whole_shift(),
-        "whole_shift_faults": loop_whole_shift_faults(),
+        **loop_whole_starts(),
         "whole_shift_raw": loop_whole_shift_raw(),
         "engagement_timer": loop_engagement(False),
         "engagement_frame_clock": loop_engagement(True),
@@ -446,9 +501,7 @@ def loop_seeds():
     }
 
 
-# --------------------------------------------------------------------------
 # calibration harness
-# --------------------------------------------------------------------------
 
 FLOAT_FIELDS = [
     "outer_radius_m", "inner_radius_m", "friction_area_m2", "piston_area_m2", "oil_conductance_W_per_K",
@@ -496,9 +549,7 @@ def calibration_seeds():
     }
 
 
-# --------------------------------------------------------------------------
 # adaptation images: fuzz_calibration with byte 0 bit 7 set (fuzz_adapt_image.c)
-# --------------------------------------------------------------------------
 
 def adapt_image(clutch_id, scales, confidences, film, kiss, shifts):
     """The adaptation image (wc_adapt_image.h): magic "WCAP", version 1, 56-byte payload, CRC-32."""
@@ -534,6 +585,8 @@ def main():
         folder.mkdir(parents=True, exist_ok=True)
         for seed, data in sorted(seeds.items()):
             (folder / seed).write_bytes(data)
+        for stale in sorted(set(f.name for f in folder.iterdir()) - set(seeds)):  # a seed no longer made
+            (folder / stale).unlink()
         print(f"{folder.relative_to(HERE.parent.parent)}: {len(seeds)} seeds, "
               f"{sum(len(d) for d in seeds.values())} bytes")
 
