@@ -28,14 +28,12 @@ CAL = ROOT / "tools" / "calibrations" / "bench_identified.toml"
 
 @pytest.fixture(scope="module")
 def wc_replay() -> Path:
-    for build in ("host-release", "host-debug"):
-        path = ROOT / "build" / build / "src" / "host" / "wc_replay"
-        if path.is_file():
-            return path
-    message = "wc_replay not built (cmake --preset host-release && cmake --build --preset host-release)"
-    if os.environ.get("CI"):
-        pytest.fail(message)
-    pytest.skip(message)
+    try:
+        return replay.wc_replay_program()
+    except FileNotFoundError as e:
+        if os.environ.get("CI"):
+            pytest.fail(str(e))
+        pytest.skip(str(e))
 
 
 def run_inproc(exe: Path, log: Path, tmp_path: Path, bench: bool = True) -> list:
