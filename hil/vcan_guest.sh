@@ -9,7 +9,14 @@
 # again (a job may have set it down), its output in out/err and its exit code
 # in rc; it stops once DIR/stop exists and no job is waiting.
 set -euo pipefail
+# shellcheck source=hil/guest_lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/guest_lib.sh"
+iface_up() {  # up already (IFF_UP in its flags): no modprobe and no ip, whose execs cost the guest a second a job
+  local flags
+  [ -r "/sys/class/net/$1/flags" ] && read -r flags < "/sys/class/net/$1/flags" && (( flags & 1 ))
+}
 up_iface() {
+  iface_up "$1" && return 0
   modprobe vcan &&
     { ip link show "$1" >/dev/null 2>&1 || ip link add dev "$1" type vcan; } &&
     ip link set up "$1"
@@ -30,7 +37,7 @@ if [ "${1:-}" = --serve ]; then
     done
     if [ -z "$job" ]; then
       [ -e "$dir/stop" ] && exit 0
-      sleep 0.1
+      pause 0.1
       continue
     fi
     : > "$job/taken"

@@ -16,6 +16,8 @@ set -uo pipefail
 _slow_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 if [ "${1:-}" = --guest ]; then   # the calibration job, in the guest
+  # shellcheck source=hil/guest_lib.sh
+  source "$_slow_repo/hil/guest_lib.sh"
   dir=$2
   replay="$_slow_repo/build/host-release/src/host/wc_replay"
   log="$_slow_repo/hil/logs/engagement_750rpm.log"
@@ -30,7 +32,7 @@ if [ "${1:-}" = --guest ]; then   # the calibration job, in the guest
   bench > "$dir/reference_ms" || exit 1
   for attempt in 1 2 3 4 5; do
     : > "$dir/request.$attempt"
-    while [ ! -e "$dir/applied.$attempt" ]; do sleep 0.1; done
+    while [ ! -e "$dir/applied.$attempt" ]; do pause 0.1; done
     [ -e "$dir/done" ] && exit 0
     bench > "$dir/result.$attempt.tmp" && mv "$dir/result.$attempt.tmp" "$dir/result.$attempt" || exit 1
   done

@@ -13,6 +13,8 @@
 # messages). Exits with the session's code.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=hil/guest_lib.sh
+source "$repo/hil/guest_lib.sh"
 die() { echo "xcp_guest: $*" >&2; exit 2; }
 [ $# -ge 1 ] || die "usage: $0 DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]"
 dir=$(cd "$1" && pwd) || die "no directory $1"; shift
@@ -41,15 +43,15 @@ mkfifo "$fifo_dir/limit"
 "$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 \
   --stats-json stats.json 2> tcu.txt &
 tcu_pid=$!
-while kill -0 "$tcu_pid" 2>/dev/null && ! grep -q "clock frame" tcu.txt; do sleep 0.05; done
-grep -q "clock frame" tcu.txt || { cat tcu.txt >&2; die "wc_tcu did not start"; }
-"$player" input.log --iface "$iface" --loops 0 --pace log --limit-fifo "$fifo_dir/limit" --stop-pid "$tcu_pid" \
+await_line tcu.txt "clock frame" "$tcu_pid" || { cat tcu.txt >&2; die "wc_tcu did not start"; }
+# the player and the master on one CPU (--cpu 0): a raw command reaches the TCU in order with the inputs
+"$player" input.log --iface "$iface" --cpu 0 --loops 0 --pace log --limit-fifo "$fifo_dir/limit" --stop-pid "$tcu_pid" \
   --record capture.log \
   --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1 2> play.txt &
 play=$!
 rc=0
 "$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" \
-  --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" > session.txt 2>&1 || rc=$?
+  --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" --cpu 0 > session.txt 2>&1 || rc=$?
 kill -TERM "$play" 2>/dev/null   # the player stops, then stops wc_tcu and records its last frames
 play_rc=0; wait "$play" || play_rc=$?
 tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?

@@ -23,6 +23,8 @@ import os
 import struct
 import sys
 import time
+
+_STARTED = time.monotonic()   # the phases' clock (_lap) starts before the heavy imports
 from pathlib import Path
 
 # python-can's MF4 writer imports asammdf, pyxcp's recorder pandas when they are installed (the project's
@@ -103,17 +105,23 @@ def _error_code(call) -> int | None:
 def _raw(bus: can.BusABC, data: bytes, steps: int = 3, **kw) -> list[bytes]:
     """Send one raw frame on the XCP command id and collect the slave's answers until the TCU has sent
     steps VfsCommands after it. wc_tcu answers a command in the iteration that receives it, and the frames
-    queued before it hold at most one step: by the third VfsCommand every answer is on the bus. What the
-    socket received before the send (its kernel timestamp, the same clock as time.time()) is not counted:
-    a drain with recv(0) left frames behind in the emulated guest, and the count ended before the answer."""
-    sent = time.time()
-    bus.send(can.Message(arbitration_id=XCP_COMMAND_ID, data=data, is_extended_id=False, **kw))
-    got, seen, end = [], 0, time.monotonic() + WAIT_LIMIT_S
+    queued before it hold at most one step (the player in lockstep, on this process's CPU: --cpu): by the
+    third VfsCommand every answer is on the bus. 'After it' is in the bus's order, not by a clock: from the
+    command's own echo on this socket (receive_own_messages), which the kernel queues to it in the same
+    delivery as to the TCU's socket, so before any answer. Kernel timestamps against time.time() missed
+    answers sent 30 us after their command in the emulated guest."""
+    command = can.Message(arbitration_id=XCP_COMMAND_ID, data=data, is_extended_id=False, **kw)
+    bus.send(command)
+    got, seen, echoed, end = [], 0, False, time.monotonic() + WAIT_LIMIT_S
     while seen < steps:
         m = bus.recv(1.0)
         if time.monotonic() > end:
-            raise TimeoutError(f"the TCU sent fewer than {steps} VfsCommands in {WAIT_LIMIT_S} s")
-        if m is None or m.is_extended_id or m.timestamp < sent:
+            raise TimeoutError(f"the TCU sent fewer than {steps} VfsCommands in {WAIT_LIMIT_S} s after the command")
+        if m is None or m.is_extended_id:
+            continue
+        if not echoed:   # what was queued before the command's echo is not its answer
+            echoed = (m.arbitration_id == XCP_COMMAND_ID and m.is_remote_frame == command.is_remote_frame
+                      and bytes(m.data) == data)
             continue
         if m.arbitration_id == XCP_RESPONSE_ID:
             got.append(bytes(m.data))
@@ -122,8 +130,17 @@ def _raw(bus: can.BusABC, data: bytes, steps: int = 3, **kw) -> list[bytes]:
     return got
 
 
+def _lap(result: dict, phase: str) -> None:
+    """The wall seconds of each phase since the previous one (printed by the test, never asserted)."""
+    now = time.monotonic()
+    seconds = result.setdefault("seconds", {})
+    seconds[phase] = round(now - result.get("_since", _STARTED), 1)
+    result["_since"] = now
+
+
 def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fifo: str | None = None) -> dict:
     """Fills result as it goes (a failure leaves what was seen before it)."""
+    _lap(result, "start-up")
     chars, meas = plan["characteristics"], plan["measurements"]
     cal_base, cal_size = plan["segments"]["calibration"]
     margin_address = chars["clutch.holding_margin"][0]
@@ -174,9 +191,11 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
                                    "accepted": _u32(xcp, meas["xcp_pages_accepted"][0])}
         # DAQ of 8 signals at the control step's event (no command beside it: on an emulated CPU pyxcp's
         # Python cannot answer commands while it decodes 8 frames a millisecond)
+        _lap(result, "connect, identity, calibration")
         with _Daq(xcp, meas, limit_fifo) as daq:
             daq.run_until(daq_samples)
         result["daq"] = daq.summary()
+        _lap(result, "daq")
         # malformed and out-of-region commands: error packets, nothing else
         result["errors"] = {
             "short_upload_outside": _error_code(lambda: xcp.shortUpload(4, 0x00500000)),
@@ -188,15 +207,18 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
             "copy_to_reference": _error_code(lambda: xcp.copyCalPage(0, 0, 0, 1)),
             "cal_page_invalid": _error_code(lambda: xcp.setCalPage(0x01, 0, 7)),
         }
+        _lap(result, "error packets")
         result["overload"] = _overload(xcp, meas)
         result["counters"] = {name: _u32(xcp, meas[name][0]) for name in
                               ("xcp_errors", "xcp_ignored", "xcp_daq_overloads", "xcp_pages_accepted",
                                "xcp_pages_rejected", "loop_deadline_misses", "loop_steps", "loop_safe_steps")}
         xcp.disconnect()
     result["disconnected"] = True
+    _lap(result, "overload, counters")
     # frames pyxcp would never send, on a socket of our own (pyxcp's would queue their answers as its own)
-    with can.Bus(interface="socketcan", channel=iface,
-                 can_filters=[{"can_id": XCP_RESPONSE_ID, "can_mask": 0x7FF},
+    with can.Bus(interface="socketcan", channel=iface, receive_own_messages=True,   # _raw: its command's echo
+                 can_filters=[{"can_id": XCP_COMMAND_ID, "can_mask": 0x7FF},
+                              {"can_id": XCP_RESPONSE_ID, "can_mask": 0x7FF},
                               {"can_id": VFS_COMMAND_ID, "can_mask": 0x7FF}]) as bus:   # _raw counts the steps
         raw = {"before_connect": _raw(bus, bytes([0xFD]))}   # GET_STATUS while disconnected: no answer
         raw["connect"] = _raw(bus, bytes([0xFF, 0x00]))
@@ -208,6 +230,8 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
             raw[name] = _raw(bus, data)
         raw["remote_frame"] = _raw(bus, b"", is_remote_frame=True)
         result["raw"] = {k: [b.hex() for b in v] for k, v in raw.items()}
+    _lap(result, "raw frames")
+    result.pop("_since", None)
     return result
 
 
@@ -307,7 +331,12 @@ def main(argv=None) -> int:
     p.add_argument("--iface", default="vcan0")
     p.add_argument("--daq-samples", type=int, default=5000, help="DAQ samples to collect (one a control step)")
     p.add_argument("--limit-fifo", help="the input player's flow control (wc_canplay --limit-fifo)")
+    p.add_argument("--cpu", type=int, help="keep to this CPU, the input player's (wc_canplay --cpu): a raw command"
+                                           " and the inputs then reach the TCU in the order sent (one CPU's vcan"
+                                           " backlog), whichever CPU the emulator stalls")
     args = p.parse_args(argv)
+    if args.cpu is not None:
+        os.sched_setaffinity(0, {args.cpu})
     result: dict = {}
     try:
         run_session(json.loads(Path(args.plan).read_text()), args.iface, args.daq_samples, result, args.limit_fifo)

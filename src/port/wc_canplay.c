@@ -3,7 +3,7 @@
  *
  *   wc_canplay LOG [--iface vcan0] [--pace answer|log] [--answer-id ID|none]
  *              [--loops N] [--answer-timeout S] [--record FILE [--record-id ID]...]
- *              [--stop-pid PID]
+ *              [--window N] [--cpu N] [--stop-pid PID]
  *
  * Plays a candump -L log on a SocketCAN interface (every frame to IFACE,
  * whatever interface the log names). A ClutchSensors frame (standard id, not
@@ -17,6 +17,13 @@
  *                   for a tool beside the TCU that expects at most the
  *                   control step's rate (XCP DAQ at the 1 ms event)
  *   --answer-id none  canplayer's pace only (the timer clock steps on its own)
+ *   --window N      up to N periods sent ahead of the last answer (default 1:
+ *                   strict lockstep). The TCU steps on each ClutchSensors frame
+ *                   in the order received, so its frames are the same for any N;
+ *                   N > 1 lets player and TCU run at once instead of waking each
+ *                   other every period (a guest's wake-up latency is most of a
+ *                   lockstep period). At most 64: the TCU's socket holds them
+ *                   (a few frames a period, its receive buffer some hundreds).
  *   --loops N       play the log N times (0: until SIGINT/SIGTERM); each loop
  *                   starts one millisecond after the previous one's last frame
  *   --record FILE   every frame sent and received, candump -L format, the socket
@@ -30,7 +37,13 @@
  *                   last period the player may step, modulo 65536 (the XCP DAQ
  *                   timestamp's range: one tick a step), or "none"; a consumer
  *                   that falls behind holds the inputs instead of losing frames
- * Prints the periods played and the answers' wait (max, total) on stderr.
+ * It keeps to one CPU (--cpu N; default the one it starts on): vcan queues each
+ * frame on the sending CPU's backlog, so a player that migrated between CPUs
+ * could have two frames of one period delivered out of order (seen with
+ * canplayer in the emulated guest); a tool that sends beside it from the same
+ * CPU has its frames reach the TCU in the order they were sent.
+ * Prints the periods played, the frames recorded and the answers' wait (max,
+ * total) on stderr.
  * Exit 0; 1 no answer within --answer-timeout (default 120 s; a stuck or
  * crashed TCU), a send or receive failed; 2 usage, an unreadable or malformed
  * log. Host program (stdio and heap allowed). */
@@ -41,6 +54,7 @@
 #include <linux/can/raw.h>
 #include <net/if.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -56,6 +70,7 @@
 #include "wetclutch_can/wc_can.h"
 
 #define MAX_RECORD_IDS 16
+#define MAX_WINDOW 64u
 
 typedef struct {
     double t_s;
@@ -74,6 +89,8 @@ typedef struct {
     size_t record_id_count;
     long stop_pid;            /* 0: none */
     const char *limit_fifo;   /* NULL: no flow control */
+    unsigned long window;     /* periods sent ahead of the last answer, 1..MAX_WINDOW */
+    int cpu;                  /* < 0: the one it starts on */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -95,7 +112,7 @@ static void usage(FILE *out)
 {
     fprintf(out, "usage: wc_canplay LOG [--iface vcan0] [--pace answer|log] [--answer-id ID|none] [--loops N]\n"
                  "                  [--answer-timeout S] [--record FILE [--record-id ID]...] [--stop-pid PID]\n"
-                 "                  [--limit-fifo PATH]\n"
+                 "                  [--limit-fifo PATH] [--window N] [--cpu N]\n"
                  "  (the header of src/port/wc_canplay.c says what each does)\n");
 }
 
@@ -206,6 +223,8 @@ static int parse_options(int argc, char **argv, options_t *o)
     o->answer_id = (int)WC_CAN_VFS_COMMAND_FRAME_ID;
     o->loops = 1u;
     o->answer_timeout_s = 120.0;
+    o->window = 1u;
+    o->cpu = -1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -238,6 +257,22 @@ static int parse_options(int argc, char **argv, options_t *o)
             o->loops = strtoul(v, &end, 10);
             if ((errno != 0) || (end == v) || (*end != '\0') || (v[0] == '-')) {
                 fprintf(stderr, "wc_canplay: --loops: '%s' is not a count\n", v);
+                return -1;
+            }
+        } else if (strcmp(a, "--cpu") == 0) {
+            errno = 0;
+            const long cpu = strtol(v, &end, 10);
+            if ((errno != 0) || (end == v) || (*end != '\0') || (cpu < 0) || (cpu >= CPU_SETSIZE)) {
+                fprintf(stderr, "wc_canplay: --cpu: '%s' is not a CPU number\n", v);
+                return -1;
+            }
+            o->cpu = (int)cpu;
+        } else if (strcmp(a, "--window") == 0) {
+            errno = 0;
+            o->window = strtoul(v, &end, 10);
+            if ((errno != 0) || (end == v) || (*end != '\0') || (v[0] == '-') || (o->window < 1u) ||
+                (o->window > MAX_WINDOW)) {
+                fprintf(stderr, "wc_canplay: --window: '%s' is not a number of periods in 1..%u\n", v, MAX_WINDOW);
                 return -1;
             }
         } else if (strcmp(a, "--answer-timeout") == 0) {
@@ -321,6 +356,7 @@ typedef struct {
     FILE *record;
     const options_t *opt;
     unsigned long long answers;
+    unsigned long long recorded;
     int limit_fd;             /* --limit-fifo, -1: none */
     bool limited;
     uint16_t limit;           /* the last period it may step, modulo 65536 */
@@ -341,6 +377,7 @@ static void record_frame(player_t *p, const struct can_frame *f)
     }
     struct timespec ts;
     (void)clock_gettime(CLOCK_REALTIME, &ts);
+    p->recorded++;
     fprintf(p->record, "(%lld.%06ld) %s ", (long long)ts.tv_sec, ts.tv_nsec / 1000L, p->opt->iface);
     fprintf(p->record, (f->can_id & CAN_EFF_FLAG) ? "%08X#" : "%03X#", (unsigned)id);
     if (f->can_id & CAN_RTR_FLAG) {
@@ -497,7 +534,16 @@ int main(int argc, char **argv)
     sa.sa_handler = on_signal;
     (void)sigaction(SIGINT, &sa, NULL);
     (void)sigaction(SIGTERM, &sa, NULL);
-    player_t p = { .fd = -1, .record = NULL, .opt = &opt, .answers = 0u, .limit_fd = -1, .limited = false,
+    const int cpu = (opt.cpu >= 0) ? opt.cpu : sched_getcpu();   /* one CPU: frames in the order sent (the header) */
+    if (cpu >= 0) {
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET((size_t)cpu, &one);
+        if (sched_setaffinity(0, sizeof one, &one) != 0) {
+            fprintf(stderr, "wc_canplay: warning: cannot keep to CPU %d: %s\n", cpu, strerror(errno));
+        }
+    }
+    player_t p = { .fd = -1, .record = NULL, .opt = &opt, .answers = 0u, .recorded = 0u, .limit_fd = -1, .limited = false,
                    .limit = 0u, .limit_line = { 0 }, .limit_len = 0u };
     if (opt.limit_fifo != NULL) {  /* read-write: no end of file while the consumer has not opened it yet */
         p.limit_fd = open(opt.limit_fifo, O_RDWR | O_NONBLOCK);
@@ -536,7 +582,8 @@ int main(int argc, char **argv)
             if ((rc == 0) && steps && (p.limit_fd >= 0) && (await_limit(&p, periods + 1u) != 0)) { rc = 1; }
             if ((rc == 0) && !stop_requested && (send_frame(&p, f) != 0)) { rc = 1; }
             if ((rc == 0) && steps && (opt.answer_id >= 0)) {
-                const double waited_s = await_answers(&p, ++periods);
+                ++periods;   /* this period's answer, or the one opt.window - 1 periods back */
+                const double waited_s = await_answers(&p, (periods >= opt.window) ? periods - opt.window + 1u : 0u);
                 if (waited_s < 0.0) { rc = 1; break; }
                 wait_total_s += waited_s;
                 if (waited_s > wait_max_s) { wait_max_s = waited_s; }
@@ -546,9 +593,12 @@ int main(int argc, char **argv)
             }
         }
     }
+    if ((rc == 0) && !stop_requested && (opt.answer_id >= 0) && (opt.window > 1u) && (await_answers(&p, periods) < 0.0)) {
+        rc = 1;   /* the answers to the last window */
+    }
     if ((p.fd >= 0) && (stop_and_drain(&p) != 0) && (rc == 0)) { rc = 1; }
-    fprintf(stderr, "wc_canplay: %llu periods in %.1f s, %llu answers; answer wait max %.1f ms, total %.1f s%s\n",
-            periods, now_s() - start_s, p.answers, wait_max_s * 1e3, wait_total_s,
+    fprintf(stderr, "wc_canplay: %llu periods in %.1f s, %llu answers, %llu frames recorded; answer wait max %.1f ms,"
+                    " total %.1f s%s\n", periods, now_s() - start_s, p.answers, p.recorded, wait_max_s * 1e3, wait_total_s,
             stop_requested ? " (stopped by a signal)" : "");
     if (p.record != NULL && fclose(p.record) != 0) {
         fprintf(stderr, "wc_canplay: --record %s: %s\n", opt.record_path, strerror(errno));

@@ -57,9 +57,9 @@ SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faul
 VCAN_MODULES = {"test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_xcp_session"}
 VCAN_TESTS = {"test_vcan_whole_shift_equals_in_process"}
-LONGEST_FIRST = ("vcan", "test_film_study", "test_identify", "test_shift", "test_whole_shift", "test_hil_replay", "test_adaptation_study",
-                 "test_adaptation_reference",
-                 "test_cli_output_faults", "test_replay_inproc", "test_lut", "test_cli_bad_input", "test_bench")
+LONGEST_FIRST = ("vcan", "test_adaptation_study", "test_identify", "test_adaptation_reference", "test_replay_inproc",
+                 "test_film_study", "test_hil_replay", "test_whole_shift", "test_shift", "test_cli_output_faults",
+                 "test_lut", "test_bench", "test_cli_bad_input")
 
 
 def pytest_configure(config):
@@ -71,22 +71,6 @@ def _group(item) -> str:
     module = item.module.__name__.rsplit(".", 1)[-1]
     vcan = module in VCAN_MODULES or (item.originalname or item.name) in VCAN_TESTS
     return "vcan" if vcan else module
-
-
-_NICE_OUTSIDE_VCAN = 10
-_niced = False
-
-
-def pytest_runtest_setup(item):
-    """With the shared vcan guest running (VCAN_SERVER, scripts/test.sh) and two workers, the worker that
-    runs the CPU-bound modules lowers its priority (and its children's: wc_replay, the plants) before its
-    first one, so the emulated guest, which replays the bench logs in real time on the other core, is not
-    starved: the vcan worker is the test command's longest path. The guest is not pytest's child."""
-    global _niced
-    if (not _niced and os.environ.get("VCAN_SERVER") and os.environ.get("PYTEST_XDIST_WORKER")
-            and _group(item) != "vcan"):
-        os.nice(_NICE_OUTSIDE_VCAN)
-        _niced = True
 
 
 def pytest_itemcollected(item):

@@ -45,6 +45,7 @@ def session(tmp_path_factory, tcu):
     code = xcp_session.run_on_vcan(work, tcu)
     result = json.loads((work / "result.json").read_text()) if (work / "result.json").is_file() else {}
     assert code == 0, f"the XCP session failed: {result.get('failed')}; see {work}/session.txt, tcu.txt"
+    print(f"\nXCP session in the guest, wall seconds per phase (printed, not asserted): {result.get('seconds')}")
     return work, result, canlog.read_log(work / "capture.log")
 
 

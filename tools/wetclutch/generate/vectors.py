@@ -86,7 +86,22 @@ def _table(name: str, ctype: str, cols: dict, order) -> str:
     return (f"/* {', '.join(order)} */\nstatic const {ctype} {name}[] = {{\n" + "\n".join(rows) + "\n};\n")
 
 
+HEADER = "wc_golden_vectors.h"
+
+
 def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
+    """Writes out_dir/HEADER (atomically); an output it cannot write is reported before the 20 s of reference
+    computation, not after."""
+    path = Path(out_dir) / HEADER
+    atomic.check_writable(path)
+    text = header_text(cal, command)
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    atomic.write_text(path, text)
+    return [str(path)]
+
+
+def header_text(cal: Calibration, command: str) -> str:
+    """The header's text: every table from the reference."""
     slip, theta, force = _grid(SLIP_RPM, THETA_DEGC, FORCE_N)
     tin = {"slip_rpm": slip, "theta_degC": theta, "force_N": force}
     tout = reference.torque(cal, tin)
@@ -105,7 +120,7 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
     eout = model.clutch_steps(edges_cal, ein["slip_rpm"], ein["theta_oil_degC"], ein["theta_housing_degC"],
                               ein["torque_request_Nm"], mode=ein["mode"], theta_start_degC=40.0)
     edges = {**ein, **eout, "hbar_um": eout["hbar_m"] * 1e6}
-    text = (
+    return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
         f" * calibration {Path(cal.path).name}. Values rounded to 9 significant digits. */\n"
@@ -140,7 +155,3 @@ def generate(cal: Calibration, out_dir: Path, command: str) -> list[str]:
         + adapt_vectors.header_part(cal)
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )
-    out_dir.mkdir(parents=True, exist_ok=True)
-    path = out_dir / "wc_golden_vectors.h"
-    atomic.write_text(path, text)
-    return [str(path)]

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import errno
 import os
 import tempfile
 from pathlib import Path
@@ -44,6 +45,24 @@ def named_error(e: OSError, path: Path | str) -> OSError:
     """The OSError e, naming path (the final output, not a temporary) and the OS reason."""
     reason = e.strerror or (os.strerror(e.errno) if e.errno else str(e))
     return OSError(e.errno, reason, str(path))
+
+
+def check_writable(final: Path | str) -> None:
+    """Before a long computation, the error its write would meet, naming final: a regular file on its path,
+    no permission to create a file where it goes (probed with a temporary, removed at once; nothing else is
+    created). A full disk shows only when written."""
+    final = Path(final)
+    where = final.parent
+    while not where.exists() and where != where.parent:   # the nearest existing directory on the path
+        where = where.parent
+    if not where.is_dir():
+        raise named_error(OSError(errno.ENOTDIR, os.strerror(errno.ENOTDIR)), final)
+    try:
+        fd, probe = tempfile.mkstemp(dir=where, prefix=f".{final.name}.", suffix=".tmp")
+    except OSError as e:
+        raise named_error(e, final) from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 _ACTIVE: contextvars.ContextVar["Staged | None"] = contextvars.ContextVar("wetclutch_atomic_active", default=None)

@@ -68,8 +68,11 @@ def _separation_bisection(cal: Calibration, p: np.ndarray):
     for _ in range(64):  # 120 sigma / 2^64 < 1e-22 m: exact in double
         mid = 0.5 * (lo + hi)
         above = contact_pressure_Pa(cal, mid) > p
-        lo = np.where(above, mid, lo)
-        hi = np.where(above, hi, mid)
+        lo_next = np.where(above, mid, lo)
+        hi_next = np.where(above, hi, mid)
+        if np.array_equal(lo_next, lo) and np.array_equal(hi_next, hi):
+            break   # a fixed point: the remaining iterations change nothing
+        lo, hi = lo_next, hi_next
     return 0.5 * (lo + hi)
 
 

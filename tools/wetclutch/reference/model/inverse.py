@@ -56,8 +56,11 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm, friction_factor: 
         mid = 0.5 * (lo + hi)
         t_mid = coulomb_per_N * cal.friction_area * contact_pressure_Pa(cal, mid) + viscous_m / film_thickness_m(cal, mid)
         high = t_mid > req
-        lo = np.where(high, mid, lo)
-        hi = np.where(high, hi, mid)
+        lo_next = np.where(high, mid, lo)
+        hi_next = np.where(high, hi, mid)
+        if np.array_equal(lo_next, lo) and np.array_equal(hi_next, hi):
+            break   # a fixed point (lo, hi adjacent or equal doubles): the remaining iterations change nothing
+        lo, hi = lo_next, hi_next
     force_curve = cal.friction_area * contact_pressure_Pa(cal, 0.5 * (lo + hi))
     force = np.where(req <= torque_at(np.full(req.shape, f_knee)), force_linear, force_curve)
 
