@@ -35,12 +35,21 @@ def database(path: Path = DBC_PATH) -> cantools.database.Database:
     return cantools.database.load_file(str(path), strict=True)
 
 
+def _crc8_j1850_byte(crc: int) -> int:
+    """SAE J1850 CRC-8 (polynomial 0x1D) of one byte, bit by bit."""
+    for _ in range(8):
+        crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc
+
+
+_CRC8_J1850_TABLE = bytes(_crc8_j1850_byte(b) for b in range(256))   # a byte at a time: every frame of a closed loop
+
+
 def crc8_j1850(data: bytes) -> int:
+    """SAE J1850 CRC-8 (AUTOSAR E2E profile 1's): init 0xFF, final XOR 0xFF."""
     crc = 0xFF
     for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+        crc = _CRC8_J1850_TABLE[crc ^ byte]
     return crc ^ 0xFF
 
 
