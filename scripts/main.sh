@@ -2,8 +2,9 @@
 # Main job: the HIL replay of the bundled 750 rpm engagement (paper Fig. 15).
 # Builds the TCU program, brings up vcan0 (natively, or in a QEMU guest where
 # the kernel has no CAN), replays hil/logs/engagement_750rpm.log with
-# canplayer, captures with candump, decodes with cantools and writes the
-# report to out/replay/engagement_750rpm/ (summary.md, metrics.json, PNG plots).
+# wc_canplay (in lockstep with the TCU's answers; it records the bus), decodes
+# with cantools and writes the report to out/replay/engagement_750rpm/
+# (summary.md, metrics.json, PNG plots).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
