@@ -59,6 +59,9 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
 #define WC_CAN_XCP_COMMAND_FRAME_ID (0x7f0u)
 #define WC_CAN_XCP_RESPONSE_FRAME_ID (0x7f1u)
+#define WC_CAN_UDS_FUNCTIONAL_REQUEST_FRAME_ID (0x7dfu)
+#define WC_CAN_UDS_PHYSICAL_REQUEST_FRAME_ID (0x7e1u)
+#define WC_CAN_UDS_RESPONSE_FRAME_ID (0x7e9u)
 
 /* Frame lengths in bytes. */
 #define WC_CAN_CLUTCH_SENSORS_LENGTH (8u)
@@ -74,6 +77,9 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
 #define WC_CAN_XCP_COMMAND_LENGTH (8u)
 #define WC_CAN_XCP_RESPONSE_LENGTH (8u)
+#define WC_CAN_UDS_FUNCTIONAL_REQUEST_LENGTH (8u)
+#define WC_CAN_UDS_PHYSICAL_REQUEST_LENGTH (8u)
+#define WC_CAN_UDS_RESPONSE_LENGTH (8u)
 
 /* Extended or standard frame types. */
 #define WC_CAN_CLUTCH_SENSORS_IS_EXTENDED (0)
@@ -89,6 +95,9 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
 #define WC_CAN_XCP_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_XCP_RESPONSE_IS_EXTENDED (0)
+#define WC_CAN_UDS_FUNCTIONAL_REQUEST_IS_EXTENDED (0)
+#define WC_CAN_UDS_PHYSICAL_REQUEST_IS_EXTENDED (0)
+#define WC_CAN_UDS_RESPONSE_IS_EXTENDED (0)
 
 /* Frame cycle times in milliseconds. */
 #define WC_CAN_CLUTCH_SENSORS_CYCLE_TIME_MS (1u)
@@ -169,6 +178,9 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
 #define WC_CAN_XCP_COMMAND_NAME "XcpCommand"
 #define WC_CAN_XCP_RESPONSE_NAME "XcpResponse"
+#define WC_CAN_UDS_FUNCTIONAL_REQUEST_NAME "UdsFunctionalRequest"
+#define WC_CAN_UDS_PHYSICAL_REQUEST_NAME "UdsPhysicalRequest"
+#define WC_CAN_UDS_RESPONSE_NAME "UdsResponse"
 
 /* Signal Names. */
 #define WC_CAN_CLUTCH_SENSORS_CRC_NAME "Crc"
@@ -246,6 +258,9 @@ extern "C" {
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
 #define WC_CAN_XCP_COMMAND_XCP_COMMAND_PID_NAME "XcpCommandPid"
 #define WC_CAN_XCP_RESPONSE_XCP_RESPONSE_PID_NAME "XcpResponsePid"
+#define WC_CAN_UDS_FUNCTIONAL_REQUEST_UDS_FUNCTIONAL_PCI_NAME "UdsFunctionalPci"
+#define WC_CAN_UDS_PHYSICAL_REQUEST_UDS_PHYSICAL_PCI_NAME "UdsPhysicalPci"
+#define WC_CAN_UDS_RESPONSE_UDS_RESPONSE_PCI_NAME "UdsResponsePci"
 
 /**
  * Signals in message ClutchSensors.
@@ -1037,6 +1052,60 @@ struct wc_can_xcp_response_t {
      * Offset: 0
      */
     uint8_t xcp_response_pid;
+};
+
+/**
+ * Signals in message UdsFunctionalRequest.
+ *
+ * UDS on CAN (ISO 14229-1 over ISO-TP, ISO 15765-2, normal addressing), functionally addressed request: a diagnostic tester to every ECU (the OBD functional id), single frames only (a functional FF, CF or FC is ignored). DLC 8 padded. Not E2E protected; not used for control; a TCU answers on UdsResponse (src/can/wc_isotp.h, wc_uds.h). Ids below the XCP ones, above every control frame: diagnostics never win arbitration over a control frame.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_uds_functional_request_t {
+    /**
+     * ISO-TP protocol control information, byte 0: high nibble the frame type (0 single frame; a functional request has no other), low nibble SF_DL; the UDS request follows.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t uds_functional_pci;
+};
+
+/**
+ * Signals in message UdsPhysicalRequest.
+ *
+ * UDS on CAN, physically addressed request: a diagnostic tester (e.g. udsoncan) to this TCU, every ISO-TP frame type (SF, FF, CF, and the FC of a segmented response). DLC 8, padded. Not E2E protected (UDS has its own request/response protocol and SecurityAccess); not used for control.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_uds_physical_request_t {
+    /**
+     * ISO-TP protocol control information, byte 0: high nibble the frame type (0 SF, 1 FF, 2 CF, 3 FC), low nibble SF_DL, FF_DL's high bits, SN or FS; the rest of the frame is the frame type's fields and the UDS data.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t uds_physical_pci;
+};
+
+/**
+ * Signals in message UdsResponse.
+ *
+ * UDS on CAN, this TCU to the tester: responses (SF, FF, CF) and the flow control of a segmented request. DLC 8, padded with 0xCC. Sent after the step's VfsCommand, never instead of it, at most one frame per control step by default (src/can/wc_isotp.h). Not E2E protected.
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_uds_response_t {
+    /**
+     * ISO-TP protocol control information, byte 0: high nibble the frame type (0 SF, 1 FF, 2 CF, 3 FC), low nibble SF_DL, FF_DL's high bits, SN or FS; the rest is the UDS response (positive: the service id + 0x40; negative: 0x7F, service id, NRC).
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t uds_response_pci;
 };
 
 /**
@@ -3169,6 +3238,183 @@ bool wc_can_xcp_response_xcp_response_pid_is_in_range(uint8_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_xcp_response_xcp_response_pid_is_in_phys_range(float value);
+
+/**
+ * Pack message UdsFunctionalRequest.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_uds_functional_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_functional_request_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message UdsFunctionalRequest.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_uds_functional_request_unpack(
+    struct wc_can_uds_functional_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from UdsFunctionalRequest.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_uds_functional_request_init(struct wc_can_uds_functional_request_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_functional_request_uds_functional_pci_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_functional_request_uds_functional_pci_is_in_phys_range(float value);
+
+/**
+ * Pack message UdsPhysicalRequest.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_uds_physical_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_physical_request_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message UdsPhysicalRequest.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_uds_physical_request_unpack(
+    struct wc_can_uds_physical_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from UdsPhysicalRequest.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_uds_physical_request_init(struct wc_can_uds_physical_request_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_physical_request_uds_physical_pci_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_physical_request_uds_physical_pci_is_in_phys_range(float value);
+
+/**
+ * Pack message UdsResponse.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_uds_response_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_response_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message UdsResponse.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_uds_response_unpack(
+    struct wc_can_uds_response_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from UdsResponse.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_uds_response_init(struct wc_can_uds_response_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_response_uds_response_pci_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_uds_response_uds_response_pci_is_in_phys_range(float value);
 
 
 #ifdef __cplusplus

@@ -77,6 +77,9 @@ extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_xcp_command_xcp_command_pid; /* 1 */
 extern const wc_can_signal_t wc_can_sig_xcp_response_xcp_response_pid; /* 1 */
+extern const wc_can_signal_t wc_can_sig_uds_functional_request_uds_functional_pci; /* 1 */
+extern const wc_can_signal_t wc_can_sig_uds_physical_request_uds_physical_pci; /* 1 */
+extern const wc_can_signal_t wc_can_sig_uds_response_uds_response_pci; /* 1 */
 
 /** ClutchSensors (0x110) in physical units. */
 typedef struct {
@@ -184,6 +187,21 @@ typedef struct {
     float xcp_response_pid;
 } wc_can_xcp_response_phys_t;
 
+/** UdsFunctionalRequest (0x7DF) in physical units. */
+typedef struct {
+    float uds_functional_pci;
+} wc_can_uds_functional_request_phys_t;
+
+/** UdsPhysicalRequest (0x7E1) in physical units. */
+typedef struct {
+    float uds_physical_pci;
+} wc_can_uds_physical_request_phys_t;
+
+/** UdsResponse (0x7E9) in physical units. */
+typedef struct {
+    float uds_response_pci;
+} wc_can_uds_response_phys_t;
+
 /* Encode: converts every signal, packs dst[0..7] (unused bits 0) and, for
  * E2E frames, writes the CRC. Decode: WC_CAN_ERR_SIZE / WC_CAN_ERR_CRC leave
  * *dst untouched; otherwise every field is written and the worst signal
@@ -214,6 +232,12 @@ wc_can_result_t wc_can_encode_xcp_command(uint8_t *dst, const wc_can_xcp_command
 wc_can_result_t wc_can_decode_xcp_command(wc_can_xcp_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_xcp_response(uint8_t *dst, const wc_can_xcp_response_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_xcp_response(wc_can_xcp_response_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_uds_functional_request(uint8_t *dst, const wc_can_uds_functional_request_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_uds_functional_request(wc_can_uds_functional_request_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_uds_physical_request(uint8_t *dst, const wc_can_uds_physical_request_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_uds_physical_request(wc_can_uds_physical_request_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_uds_response(uint8_t *dst, const wc_can_uds_response_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_uds_response(wc_can_uds_response_phys_t *dst, const uint8_t *src, size_t size);
 
 #ifdef __cplusplus
 }

@@ -172,6 +172,7 @@ typedef struct {
                                              * the engine request of the last step */
     uint8_t tx_alive_offgoing;
     uint8_t tx_alive_engine;
+    bool adaptation_reset_requested;        /* wc_loop_request_adaptation_reset: taken at the next step */
 } wc_loop_t;
 
 /* Validate the calibration (and the shift calibration: a failing one returns
@@ -201,6 +202,13 @@ wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal,
  * a call the loop starts from the calibration's values with IMAGE_MISSING.
  * Returns the image load's code (wc_adapt_image.h). */
 uint32_t wc_loop_load_adaptation(wc_loop_t *loop, const uint8_t *image, size_t length);
+
+/* Reset the clutch's learned values as ShiftCommand.AdaptationReset does (DESIGN 12), on a diagnostic
+ * tester's request (UDS RoutineControl, wc_uds.h): taken at the next wc_loop_step, which then sends the
+ * AdaptationReport and calls the adaptation hook; unlike the CAN bit, also in the safe state and in any
+ * mode. Returns false (nothing requested) when adaptation is off (no shift calibration, or its adaptation
+ * 0) or a shift runs. Same context as wc_loop_step, never beside it. */
+bool wc_loop_request_adaptation_reset(wc_loop_t *loop);
 
 /* Queue one received frame for the next step. Returns false (and counts
  * WC_REJECT_OVERFLOW) when the ring is full. */

@@ -101,6 +101,17 @@ uint32_t wc_loop_load_adaptation(wc_loop_t *loop, const uint8_t *image, size_t l
     return wc_adapt_image_load(&loop->adapt, loop->config.shift, 0u, image, length);
 }
 
+bool wc_loop_request_adaptation_reset(wc_loop_t *loop)
+{
+    WC_ASSERT(loop != NULL);
+    if ((loop == NULL) || (loop->config.shift == NULL) || (loop->config.shift->adaptation != 1u) ||
+        wc_shift_phase_running(loop->shift.phase)) {
+        return false;
+    }
+    loop->adaptation_reset_requested = true;
+    return true;
+}
+
 /* Status bit of each reject reason, indexed by wc_loop_reject_t in its
  * order. SYNC frames are in sequence: no error, the input's timeout bit
  * says it is not yet used. */
@@ -480,7 +491,11 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     /* DESIGN 12: a reset of the learned values on a 0 -> 1 edge of the (valid) AdaptationReset, not during a shift */
     const bool reset = (loop->config.shift != NULL) && (loop->config.shift->adaptation == 1u) && shift_mode &&
                        (loop->shift_command.adaptation_reset > 0.5f);
-    if (reset && !loop->last_adaptation_reset && !shift_running && !safe) {
+    /* ...or requested by a diagnostic routine (wc_loop_request_adaptation_reset; an authenticated tester,
+     * so also in the safe state), dropped if a shift started since */
+    const bool requested = loop->adaptation_reset_requested && !shift_running;
+    loop->adaptation_reset_requested = false;
+    if ((reset && !loop->last_adaptation_reset && !shift_running && !safe) || requested) {
         loop->report.adaptation = wc_adapt_command_reset(&loop->adapt);
         step |= STEP_ADAPT;
     }

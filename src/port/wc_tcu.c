@@ -7,7 +7,9 @@
  * On exit (SIGINT, SIGTERM, --steps reached, or --idle-exit seconds without a
  * frame after the first one) it
  * prints frames in/out, rejects by reason, timeouts, deadline misses and the
- * step-time max and percentiles, and optionally writes them as JSON. */
+ * step-time max and percentiles, and optionally writes them as JSON.
+ *   --uds          the diagnostic server (ISO-TP + UDS + fault memory,
+ *                  wc_tcu_diag.h), stepped after the step's control frames */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <getopt.h>
@@ -32,6 +34,7 @@
 #include "wc_loop_stats.h"
 #include "wc_tcu_calibrations.h"
 #include "wc_xcp_signals.h"
+#include "wc_tcu_diag.h"
 
 /* Step-time histogram: 1 us bins up to 50 ms, one overflow bin; the max is kept exactly. */
 #define HIST_BIN_NS 1000
@@ -60,6 +63,12 @@ typedef struct {
     int bench;                /* --bench: BenchMeasurement used (and passed by the kernel filter) */
     int realtime;             /* --realtime: SCHED_FIFO + mlockall where permitted */
     int xcp;                  /* --xcp: the XCP on CAN slave (wc_xcp.h) on the same interface */
+    int uds;                  /* --uds: the diagnostic server (wc_tcu_diag.h) on the same interface */
+    const char *secret_file;  /* --secret-file: the device secret of SecurityAccess */
+    const char *dtc_file;     /* --dtc-file: the fault memory's image */
+    const char *serial;       /* --serial: DID 0xF18C */
+    unsigned security_delay_ms;  /* --security-delay-ms */
+    unsigned uds_frames_per_step;  /* --uds-frames-per-step */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -124,6 +133,17 @@ static void usage(FILE *out)
             "      --realtime            SCHED_FIFO priority 50 and mlockall, where permitted (reported)\n"
             "      --xcp                 XCP on CAN slave (XcpCommand 0x7F0 / XcpResponse 0x7F1): calibration page\n"
             "                            and DAQ for a calibration tool (README: Calibration over XCP)\n"
+            "      --uds                 UDS diagnostics over ISO-TP (UdsPhysicalRequest 0x7E1, UdsFunctionalRequest\n"
+            "                            0x7DF, UdsResponse 0x7E9): identity, DIDs, DTCs, SecurityAccess, adaptation\n"
+            "                            reset routine; after the step's control frames, one frame a step by default\n"
+            "      --secret-file FILE    with --uds (required): the device secret (16..1024 bytes); the key of a\n"
+            "                            seed is HMAC-SHA256(secret, seed), its first 16 bytes\n"
+            "      --dtc-file FILE       with --uds: the fault memory's image, read at start (missing: empty;\n"
+            "                            corrupt: empty and DTC 0x062F00) and written atomically on change and at exit\n"
+            "      --serial TEXT         with --uds: the ECU serial number (DID 0xF18C; default WC0000000001)\n"
+            "      --security-delay-ms N with --uds: the SecurityAccess delay after 3 wrong keys and at start\n"
+            "                            (default 10000)\n"
+            "      --uds-frames-per-step N  with --uds: diagnostic frames sent per step at most (1..8, default 1)\n"
             "      --xcp-layout          print the XCP regions and the measured signals' addresses as JSON\n"
             "                            (for `wetclutch a2l`) and exit\n"
             "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
@@ -179,9 +199,13 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"shift", required_argument, NULL, 's'},       {"adaptation-file", required_argument, NULL, 4},
         {"calibration-image", required_argument, NULL, 5}, {"xcp", no_argument, NULL, 6},
         {"xcp-layout", no_argument, NULL, 7},
+        {"uds", no_argument, NULL, 8},                 {"secret-file", required_argument, NULL, 9},
+        {"dtc-file", required_argument, NULL, 10},     {"serial", required_argument, NULL, 11},
+        {"security-delay-ms", required_argument, NULL, 12}, {"uds-frames-per-step", required_argument, NULL, 13},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
-                     .sensor_timeout = 10u, .request_timeout = 10u};
+                     .sensor_timeout = 10u, .request_timeout = 10u, .security_delay_ms = 10000u,
+                     .uds_frames_per_step = 1u};
     double v = 0.0;
     int c;
     while ((c = getopt_long(argc, argv, "i:c:p:k:s:n:I:t:j:bh", longopts, NULL)) != -1) {
@@ -205,6 +229,12 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 3: o->realtime = 1; break;
         case 6: o->xcp = 1; break;
         case 7: print_xcp_layout(); exit(0);
+        case 8: o->uds = 1; break;
+        case 9: o->secret_file = optarg; break;
+        case 10: o->dtc_file = optarg; break;
+        case 11: o->serial = optarg; break;
+        case 12: if (parse_number(optarg, "--security-delay-ms", 0, 3600000, &v)) { return -1; } o->security_delay_ms = (unsigned)v; break;
+        case 13: if (parse_number(optarg, "--uds-frames-per-step", 1, WC_ISOTP_MAX_FRAMES_PER_STEP, &v)) { return -1; } o->uds_frames_per_step = (unsigned)v; break;
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 'h':
@@ -219,6 +249,14 @@ static int parse_options(int argc, char **argv, options_t *o)
         }
     }
     if (optind < argc) { fprintf(stderr, "wc_tcu: unexpected argument '%s'\n", argv[optind]); return -1; }
+    if (!o->uds && ((o->secret_file != NULL) || (o->dtc_file != NULL) || (o->serial != NULL))) {
+        fprintf(stderr, "wc_tcu: --secret-file, --dtc-file and --serial need --uds\n");
+        return -1;
+    }
+    if (o->uds && (o->secret_file == NULL)) {
+        fprintf(stderr, "wc_tcu: --uds needs --secret-file FILE (the device secret of SecurityAccess)\n");
+        return -1;
+    }
     if ((o->calibration_image != NULL) && o->compiled_in_given) {
         fprintf(stderr, "wc_tcu: --calibration-image holds the whole calibration: not with --calibration, --shift,"
                         " --sensor-timeout or --request-timeout\n");
@@ -347,8 +385,8 @@ static void send_frames(wc_loop_t *loop, wc_socketcan_t *port, port_stats_t *ps,
     }
 }
 
-static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_socketcan_t *port, step_times_t *times,
-               port_stats_t *ps)
+static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_tcu_diag_t *diag, wc_socketcan_t *port,
+               step_times_t *times, port_stats_t *ps)
 {
     int64_t last_rx = -1;  /* the idle timer starts with the first frame */
     const wc_loop_clock_t clock = opt->frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
@@ -406,15 +444,22 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_socketca
         /* an XCP command goes to the slave, every other frame to the loop */
         const bool xcp_frame = (xcp != NULL) && (got == WC_SOCKETCAN_FRAME) && (frame.id == WC_CAN_XCP_COMMAND_FRAME_ID);
         if (xcp_frame) { (void)wc_xcp_receive(xcp, &frame); }  /* a full ring is counted */
+        /* a UDS request goes to the diagnostic server (the loop would count it an unknown id) */
+        const bool uds_frame = (diag != NULL) && (got == WC_SOCKETCAN_FRAME) && wc_tcu_diag_is_request(frame.id);
+        if (uds_frame) { wc_tcu_diag_receive(diag, &frame); }
         const int64_t t0 = now_ns();
         wc_can_frame_t out[WC_LOOP_TX_FRAMES];
-        const uint32_t n = wc_loop_iterate(loop, clock, ((got == WC_SOCKETCAN_FRAME) && !xcp_frame) ? &frame : NULL,
+        const uint32_t n = wc_loop_iterate(loop, clock, ((got == WC_SOCKETCAN_FRAME) && !xcp_frame && !uds_frame) ? &frame : NULL,
                                            tick, out);
         send_frames(loop, port, ps, out, n);  /* VfsCommand first, before any XCP frame */
         if (n > 0u) { record(times, now_ns() - t0); }
         if (xcp != NULL) {  /* after the step's frames: commands, a changed page, the step's DAQ sample */
             wc_can_frame_t xout[WC_XCP_TX_FRAMES];
             send_frames(loop, port, ps, xout, wc_xcp_step(xcp, n > 0u, xout));
+        }
+        if ((diag != NULL) && (n > 0u)) {  /* after the step's frames: the fault tests, then one server step */
+            wc_can_frame_t dout[WC_TCU_DIAG_TX_FRAMES];
+            send_frames(loop, port, ps, dout, wc_tcu_diag_step(diag, out, n, dout, WC_TCU_DIAG_TX_FRAMES));
         }
     }
     if (timer_fd >= 0) { (void)close(timer_fd); }
@@ -508,10 +553,31 @@ int main(int argc, char **argv)
     static wc_xcp_t xcp;
     if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config) != 0)) { return 2; }
 
+    /* The diagnostic server: the calibration image the loop runs (its CRC is a DID), the fault memory. */
+    static wc_tcu_diag_t diag;
+    if (opt.uds) {
+        static wc_cal_set_t set;
+        static uint8_t cal_image[WC_CAL_IMAGE_FILE_MAX_BYTES];
+        size_t cal_image_length = 0u;
+        if (wc_cal_set_from(&set, cal, config.shift, &config)) {
+            cal_image_length = wc_cal_image_write(&set, cal_image, sizeof cal_image);
+        }
+        const wc_tcu_diag_options_t diag_options = {
+            "wc_tcu", opt.secret_file, opt.dtc_file, opt.serial, (uint32_t)(opt.period_ns / 1000),
+            opt.security_delay_ms, opt.uds_frames_per_step };
+        if (wc_tcu_diag_open(&diag, &diag_options, &loop, opt.xcp ? &xcp : NULL, cal_image, cal_image_length) != 0) {
+            return 2;
+        }
+    }
+
     wc_socketcan_t port;
-    uint32_t ids[WC_LOOP_RX_ID_COUNT + 1u];
+    uint32_t ids[WC_LOOP_RX_ID_COUNT + 3u];
     uint32_t id_count = wc_loop_rx_ids(&config, ids);  /* ShiftCommand only with --shift, bench only with --bench */
     if (opt.xcp) { ids[id_count++] = WC_CAN_XCP_COMMAND_FRAME_ID; }
+    if (opt.uds) {
+        ids[id_count++] = WC_CAN_UDS_PHYSICAL_REQUEST_FRAME_ID;
+        ids[id_count++] = WC_CAN_UDS_FUNCTIONAL_REQUEST_FRAME_ID;
+    }
     if (wc_socketcan_open(&port, opt.iface, ids, id_count) != 0) {
         fprintf(stderr, "wc_tcu: %s\n", port.error);
         return 1;
@@ -522,8 +588,9 @@ int main(int argc, char **argv)
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
     port_stats_t ps = { 0u, 0u, 0u, 0 };
-    const int status = run(&opt, &loop, (opt.xcp != 0) ? &xcp : NULL, &port, &times, &ps);
+    const int status = run(&opt, &loop, (opt.xcp != 0) ? &xcp : NULL, opt.uds ? &diag : NULL, &port, &times, &ps);
     wc_socketcan_close(&port);
+    if (opt.uds) { wc_tcu_diag_close(&diag); }
     report(stderr, 0, &loop.counters, ps.tx_errors, port.rx_dropped, &times);
     if ((opt.stats_json != NULL) && (write_stats_json(opt.stats_json, &loop.counters, &ps, port.rx_dropped, &times) != 0)) {
         return 1;

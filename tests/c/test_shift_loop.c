@@ -349,6 +349,24 @@ static void test_loop_adaptation_report_hook_and_reset(void **state)
     (void)adaptive_period(&l, 0, true, 1.2f, &a, &had);  /* held: no second reset */
     assert_false(had);
     assert_int_equal(log.calls, 2u);
+    /* a diagnostic tester's request (UDS routine 0x0201): taken at the next step, reported and stored once */
+    assert_true(wc_loop_request_adaptation_reset(&l.loop));
+    (void)adaptive_period(&l, 0, false, 1.2f, &a, &had);
+    assert_true(had);
+    assert_float_equal(a.result, 0.0f, 0.0f);
+    assert_int_equal(log.calls, 3u);
+    assert_false(l.loop.adaptation_reset_requested);
+    (void)adaptive_period(&l, 0, false, 1.2f, &a, &had);
+    assert_false(had);
+    /* refused while a shift runs, and without adaptation */
+    for (int k = 0; (k < 50) && !wc_shift_phase_running(l.loop.shift.phase); ++k) {
+        (void)adaptive_period(&l, 1, false, 1.2f, &a, &had);
+    }
+    assert_true(wc_shift_phase_running(l.loop.shift.phase));
+    assert_false(wc_loop_request_adaptation_reset(&l.loop));
+    static loop_sim_t plain;
+    loop_start(&plain, &test_cal);  /* adaptation 0 */
+    assert_false(wc_loop_request_adaptation_reset(&plain.loop));
 }
 
 int main(void)

@@ -46,6 +46,10 @@ FRAMES = {
     # XCP on CAN (DESIGN 13): event-driven command/response, not E2E, the lowest priority on the bus
     "XcpCommand": (0x7F0, "TOOL", {"TCU"}, None, False),
     "XcpResponse": (0x7F1, "TCU", {"TOOL"}, None, False),
+    # UDS on CAN over ISO-TP (DESIGN 17): event-driven request/response, not E2E, above every control frame
+    "UdsFunctionalRequest": (0x7DF, "TOOL", {"TCU"}, None, False),
+    "UdsPhysicalRequest": (0x7E1, "TOOL", {"TCU"}, None, False),
+    "UdsResponse": (0x7E9, "TCU", {"TOOL"}, None, False),
 }
 # Layout constants of src/can/wc_e2e.h.
 E2E_CRC_START, E2E_CRC_LEN = 0, 8
@@ -60,6 +64,7 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
 ]
 # Integer signals that the scaling wrapper does not convert.
 UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", "Fallback", "XcpCommandPid", "XcpResponsePid",
+            "UdsFunctionalPci", "UdsPhysicalPci", "UdsResponsePci",
             *STATUS_BITS}
 
 
@@ -132,6 +137,16 @@ def test_e2e_layout(db, name):
 def test_e2e_data_ids_distinct():
     ids = [fid & 0xFF for fid, *_rest, e2e in FRAMES.values() if e2e]
     assert len(set(ids)) == len(ids)
+
+
+def test_frame_ids_distinct_and_diagnostics_below_control_priority(db):
+    """No two frames share an id; the diagnostic (UDS) and calibration (XCP) ids lose arbitration to every
+    control frame (a higher id is a lower priority)."""
+    ids = [m.frame_id for m in db.messages]
+    assert len(set(ids)) == len(ids)
+    service = {FRAMES[n][0] for n in FRAMES if n.startswith(("Uds", "Xcp"))}
+    control = {FRAMES[n][0] for n in FRAMES if not n.startswith(("Uds", "Xcp"))}
+    assert min(service) > max(control)
 
 
 def test_status_bits(db):

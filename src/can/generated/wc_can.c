@@ -1644,3 +1644,156 @@ bool wc_can_xcp_response_xcp_response_pid_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 255.0f));
 }
+
+int wc_can_uds_functional_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_functional_request_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->uds_functional_pci, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_uds_functional_request_unpack(
+    struct wc_can_uds_functional_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->uds_functional_pci = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_uds_functional_request_init(struct wc_can_uds_functional_request_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_uds_functional_request_t));
+
+    return 0;
+}
+
+bool wc_can_uds_functional_request_uds_functional_pci_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_uds_functional_request_uds_functional_pci_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+int wc_can_uds_physical_request_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_physical_request_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->uds_physical_pci, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_uds_physical_request_unpack(
+    struct wc_can_uds_physical_request_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->uds_physical_pci = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_uds_physical_request_init(struct wc_can_uds_physical_request_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_uds_physical_request_t));
+
+    return 0;
+}
+
+bool wc_can_uds_physical_request_uds_physical_pci_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_uds_physical_request_uds_physical_pci_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+int wc_can_uds_response_pack(
+    uint8_t *dst_p,
+    const struct wc_can_uds_response_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->uds_response_pci, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_uds_response_unpack(
+    struct wc_can_uds_response_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->uds_response_pci = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_uds_response_init(struct wc_can_uds_response_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_uds_response_t));
+
+    return 0;
+}
+
+bool wc_can_uds_response_uds_response_pci_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_uds_response_uds_response_pci_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}

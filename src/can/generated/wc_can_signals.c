@@ -174,6 +174,18 @@ const wc_can_signal_t wc_can_sig_xcp_response_xcp_response_pid = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
+const wc_can_signal_t wc_can_sig_uds_functional_request_uds_functional_pci = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_uds_physical_request_uds_physical_pci = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_uds_response_uds_response_pci = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 255,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
 
 /* ---- frames ---- */
 
@@ -746,5 +758,101 @@ wc_can_result_t wc_can_decode_xcp_response(wc_can_xcp_response_phys_t *dst, cons
         return WC_CAN_ERR_SIZE;
     }
     dst->xcp_response_pid = to_phys(&wc_can_sig_xcp_response_xcp_response_pid, msg.xcp_response_pid, &result);
+    return result;
+}
+
+/* UdsFunctionalRequest */
+
+wc_can_result_t wc_can_encode_uds_functional_request(uint8_t *dst, const wc_can_uds_functional_request_phys_t *src, size_t size)
+{
+    struct wc_can_uds_functional_request_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_FUNCTIONAL_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.uds_functional_pci = (uint8_t)to_raw(&wc_can_sig_uds_functional_request_uds_functional_pci, src->uds_functional_pci, &result);
+    if (wc_can_uds_functional_request_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_uds_functional_request(wc_can_uds_functional_request_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_uds_functional_request_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_FUNCTIONAL_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_uds_functional_request_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->uds_functional_pci = to_phys(&wc_can_sig_uds_functional_request_uds_functional_pci, msg.uds_functional_pci, &result);
+    return result;
+}
+
+/* UdsPhysicalRequest */
+
+wc_can_result_t wc_can_encode_uds_physical_request(uint8_t *dst, const wc_can_uds_physical_request_phys_t *src, size_t size)
+{
+    struct wc_can_uds_physical_request_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_PHYSICAL_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.uds_physical_pci = (uint8_t)to_raw(&wc_can_sig_uds_physical_request_uds_physical_pci, src->uds_physical_pci, &result);
+    if (wc_can_uds_physical_request_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_uds_physical_request(wc_can_uds_physical_request_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_uds_physical_request_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_PHYSICAL_REQUEST_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_uds_physical_request_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->uds_physical_pci = to_phys(&wc_can_sig_uds_physical_request_uds_physical_pci, msg.uds_physical_pci, &result);
+    return result;
+}
+
+/* UdsResponse */
+
+wc_can_result_t wc_can_encode_uds_response(uint8_t *dst, const wc_can_uds_response_phys_t *src, size_t size)
+{
+    struct wc_can_uds_response_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_RESPONSE_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.uds_response_pci = (uint8_t)to_raw(&wc_can_sig_uds_response_uds_response_pci, src->uds_response_pci, &result);
+    if (wc_can_uds_response_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    return result;
+}
+
+wc_can_result_t wc_can_decode_uds_response(wc_can_uds_response_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_uds_response_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_UDS_RESPONSE_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_can_uds_response_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->uds_response_pci = to_phys(&wc_can_sig_uds_response_uds_response_pci, msg.uds_response_pci, &result);
     return result;
 }
