@@ -2,8 +2,9 @@
 # A calibration tool's XCP session against wc_tcu on a live SocketCAN interface (DESIGN 13), where the
 # interface exists (natively, or inside the guest of hil/vcan_run.sh):
 #   bash hil/xcp_guest.sh DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]
-# DIR holds input.log (the TCU's inputs), cal.img (the calibration image wc_tcu starts from) and plan.json
-# (the A2L's addresses and the image's bytes there, tools/wetclutch/hil/xcp_session.py). wc_tcu --xcp runs
+# DIR holds input.log (the TCU's inputs), cal.img (the calibration image wc_tcu starts from), plan.json
+# (the A2L's addresses and the image's bytes there, tools/wetclutch/hil/xcp_session.py) and secret.bin (the
+# device secret: wc_tcu --secret-file locks CAL/PAG behind XCP seed & key, the master computes the key). wc_tcu --xcp runs
 # with the frame clock; wc_canplay plays input.log in a loop, each period once the TCU's VfsCommand for the
 # last one is on the bus, never faster than the log and, during DAQ, never more than a few hundred steps
 # ahead of the master's decoding (DESIGN 5: a slower guest makes the session slower, never different),
@@ -28,7 +29,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 player=$(dirname "$tcu")/wc_canplay
-for f in input.log cal.img plan.json; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
+for f in input.log cal.img plan.json secret.bin; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
 for program in "$tcu" "$player"; do
   [ -x "$program" ] || die "$program not built (cmake --preset host-release && cmake --build --preset host-release)"
 done
@@ -40,7 +41,7 @@ cd "$dir"
 fifo_dir=$(mktemp -d /dev/shm/xcp.XXXXXX 2>/dev/null || mktemp -d)
 trap 'rm -rf "$fifo_dir"' EXIT
 mkfifo "$fifo_dir/limit"
-"$tcu" --iface "$iface" --clock frame --xcp --calibration-image cal.img --theta-start 60 \
+"$tcu" --iface "$iface" --clock frame --xcp --secret-file secret.bin --calibration-image cal.img --theta-start 60 \
   --stats-json stats.json 2> tcu.txt &
 tcu_pid=$!
 await_line tcu.txt "clock frame" "$tcu_pid" || { cat tcu.txt >&2; die "wc_tcu did not start"; }
@@ -50,7 +51,7 @@ await_line tcu.txt "clock frame" "$tcu_pid" || { cat tcu.txt >&2; die "wc_tcu di
   --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1 2> play.txt &
 play=$!
 rc=0
-"$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" \
+"$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" --secret-file secret.bin \
   --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" --cpu 0 > session.txt 2>&1 || rc=$?
 kill -TERM "$play" 2>/dev/null   # the player stops, then stops wc_tcu and records its last frames
 play_rc=0; wait "$play" || play_rc=$?

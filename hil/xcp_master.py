@@ -2,14 +2,17 @@
 """The XCP master's side of a calibration session against ``wc_tcu --xcp`` (DESIGN 13), run where the
 SocketCAN interface is (natively, or inside the QEMU guest of hil/vcan_run.sh) by hil/xcp_guest.sh:
 
-    python hil/xcp_master.py --plan PLAN.json --out RESULT.json [--iface vcan0] [--daq-samples 5000]
+    python hil/xcp_master.py --plan PLAN.json --out RESULT.json --secret-file SECRET [--iface vcan0]
+                             [--daq-samples 5000]
 
 The master is pyxcp over python-can, nobody's code here. PLAN.json is written on the host by
 tools/wetclutch/hil/xcp_session.py: the A2L's addresses as pya2ldb reads them and the bytes the calibration
 image holds at each characteristic. This script imports nothing else (no wetclutch, no A2L parser): on an
 emulated CPU every import costs seconds. It records what it saw in RESULT.json (as far as it got, if a step
-fails); tests/python/test_xcp_session.py checks it with the bus capture. The session: connect, identity,
-checksum of the calibration page, every characteristic read back at its A2L address, a new holding margin
+fails); tests/python/test_xcp_session.py checks it with the bus capture. The session: connect, a DOWNLOAD
+refused while CAL/PAG is locked (ERR_ACCESS_LOCKED), the unlock by pyxcp's seed & key (cond_unlock with a
+seed_n_key_function: the key is HMAC-SHA256(device secret, seed), its first bytes), identity, checksum of
+the calibration page, every characteristic read back at its A2L address, a new holding margin
 downloaded, an invalid one refused, DAQ of 8 signals at the control step's 1 ms event, error packets for
 out-of-region and malformed commands, a DAQ overload, disconnect, and raw frames no master would send.
 Every wait is on the TCU's steps (its loop_steps counter, its VfsCommand frames) or on a sample count, never
@@ -18,6 +21,8 @@ session slower, never different (DESIGN 5)."""
 from __future__ import annotations
 
 import argparse
+import hashlib
+import hmac
 import json
 import os
 import struct
@@ -36,18 +41,19 @@ import can  # noqa: E402
 
 XCP_COMMAND_ID, XCP_RESPONSE_ID, VFS_COMMAND_ID = 0x7F0, 0x7F1, 0x120   # hil/wetclutch.dbc
 DAQ_WINDOW_STEPS = 200  # flow control: the inputs may run this many steps ahead of the last decoded DAQ sample
-WAIT_LIMIT_S = 600.0    # a wait for the TCU's steps that takes longer: it stopped stepping (a failure, said so)
+WAIT_LIMIT_S = 600.0    # no progress for this long (no step, no DAQ sample): the TCU stopped (a failure, said so);
+                        # a limit on progress, not on the whole wait, so a slow guest only takes longer
 DAQ_SIGNALS = ("current_mA", "pressure_model_Pa", "force_command_N", "contact_force_N", "theta_degC",
                "model_torque_Nm", "slip_rad_s", "torque_request_Nm")
 
 
-def _master(iface: str):
+def _master(iface: str, seed_n_key):
     from pyxcp.config import create_application_from_config, set_application
     from pyxcp.master import Master
     app = create_application_from_config({
         "Transport": {"CAN": {"interface": "socketcan", "channel": iface, "can_id_master": XCP_COMMAND_ID,
                               "can_id_slave": XCP_RESPONSE_ID, "max_dlc_required": False}},
-        "General": {"disable_error_handling": True}}, log_level=30)
+        "General": {"disable_error_handling": True, "seed_n_key_function": seed_n_key}}, log_level=30)
     app.transport.timeout = 30.0   # an emulated CPU decoding 8 DAQ frames a millisecond sees answers late
     set_application(app)   # pyxcp's DAQ processor asks for the application (else it parses sys.argv)
     return Master("can", config=app)
@@ -87,9 +93,13 @@ def _wait_steps(xcp, meas: dict, steps: int) -> None:
     """Until the TCU's loop_steps counter has advanced by steps (each upload is answered between two steps)."""
     address = meas["loop_steps"][0]
     start, end = _u32(xcp, address), time.monotonic() + WAIT_LIMIT_S
-    while (_u32(xcp, address) - start) % (1 << 32) < steps:
+    last = start
+    while ((now := _u32(xcp, address)) - start) % (1 << 32) < steps:
+        if now != last:   # progress: the limit starts again
+            last, end = now, time.monotonic() + WAIT_LIMIT_S
         if time.monotonic() > end:
-            raise TimeoutError(f"the TCU made fewer than {steps} steps in {WAIT_LIMIT_S} s: are its inputs played?")
+            raise TimeoutError(f"the TCU made no step in {WAIT_LIMIT_S} s ({(now - start) % (1 << 32)} of {steps}):"
+                               " are its inputs played?")
 
 
 def _error_code(call) -> int | None:
@@ -130,6 +140,25 @@ def _raw(bus: can.BusABC, data: bytes, steps: int = 3, **kw) -> list[bytes]:
     return got
 
 
+KEY_BYTES = 6   # WC_XCP_KEY_MAX_BYTES: the key in one UNLOCK frame
+
+
+def _seed_and_key(secret: bytes, seeds: list):
+    """pyxcp's seed_n_key_function (a plain function: pyxcp logs its __name__): the key of a seed is the
+    first KEY_BYTES bytes of HMAC-SHA256(device secret, seed), as wc_tcu computes it (OpenSSL there,
+    Python's hmac here); each (resource, seed) seen is appended to seeds."""
+    def hmac_key(resource: int, seed: bytes) -> bytes:
+        seeds.append((int(resource), bytes(seed).hex()))
+        return hmac.new(secret, bytes(seed), hashlib.sha256).digest()[:KEY_BYTES]
+    return hmac_key
+
+
+def _protection(status) -> dict:
+    """GET_STATUS's resource protection status: the resources still locked."""
+    p = status.resourceProtectionStatus
+    return {"calpag": bool(p.calpag), "daq": bool(p.daq)}
+
+
 def _lap(result: dict, phase: str) -> None:
     """The wall seconds of each phase since the previous one (printed by the test, never asserted)."""
     now = time.monotonic()
@@ -138,19 +167,28 @@ def _lap(result: dict, phase: str) -> None:
     result["_since"] = now
 
 
-def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fifo: str | None = None) -> dict:
+def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fifo: str | None = None,
+                secret: bytes = b"") -> dict:
     """Fills result as it goes (a failure leaves what was seen before it)."""
     _lap(result, "start-up")
     chars, meas = plan["characteristics"], plan["measurements"]
     cal_base, cal_size = plan["segments"]["calibration"]
     margin_address = chars["clutch.holding_margin"][0]
-    with _master(iface) as xcp:
+    seeds: list = []
+    with _master(iface, _seed_and_key(secret, seeds)) as xcp:
         t = time.monotonic()
         connect = xcp.connect()
         result["connect"] = {"max_cto": connect.maxCto, "max_dto": connect.maxDto, "seconds": time.monotonic() - t,
                              "cal_pag": bool(connect.resource.calpag), "daq": bool(connect.resource.daq)}
         status = xcp.getStatus()
         result["daq_running_at_connect"] = bool(status.sessionStatus.daqRunning)
+        # seed & key: a write before the unlock refused, then pyxcp's unlock with the HMAC key
+        result["protection_at_connect"] = _protection(status)
+        xcp.setMta(margin_address)
+        result["download_before_unlock"] = _error_code(lambda: xcp.download(struct.pack("<f", 0.5)))
+        xcp.cond_unlock("calpag")
+        result["unlock_seeds"] = seeds
+        result["protection_after_unlock"] = _protection(xcp.getStatus())
         idents = {}
         for kind in (0, 1):
             gid = xcp.getId(kind)
@@ -276,10 +314,10 @@ class _Daq:
         end, held = time.monotonic() + WAIT_LIMIT_S, None
         while (decoded := len(self.samples.rows)) < samples:
             if time.monotonic() > end:
-                raise TimeoutError(f"{decoded} DAQ samples of {samples} in {WAIT_LIMIT_S} s")
+                raise TimeoutError(f"{decoded} DAQ samples of {samples}, none new in {WAIT_LIMIT_S} s")
             if decoded != held:   # the inputs at most DAQ_WINDOW_STEPS ahead of what is decoded
                 self._hold_at(self.steps_at_start + decoded + DAQ_WINDOW_STEPS)
-                held = decoded
+                held, end = decoded, time.monotonic() + WAIT_LIMIT_S   # progress: the limit starts again
             time.sleep(0.02)
 
     def __exit__(self, *exc):
@@ -331,6 +369,7 @@ def main(argv=None) -> int:
     p.add_argument("--iface", default="vcan0")
     p.add_argument("--daq-samples", type=int, default=5000, help="DAQ samples to collect (one a control step)")
     p.add_argument("--limit-fifo", help="the input player's flow control (wc_canplay --limit-fifo)")
+    p.add_argument("--secret-file", required=True, help="the device secret wc_tcu --secret-file keys XCP with")
     p.add_argument("--cpu", type=int, help="keep to this CPU, the input player's (wc_canplay --cpu): a raw command"
                                            " and the inputs then reach the TCU in the order sent (one CPU's vcan"
                                            " backlog), whichever CPU the emulator stalls")
@@ -339,7 +378,8 @@ def main(argv=None) -> int:
         os.sched_setaffinity(0, {args.cpu})
     result: dict = {}
     try:
-        run_session(json.loads(Path(args.plan).read_text()), args.iface, args.daq_samples, result, args.limit_fifo)
+        run_session(json.loads(Path(args.plan).read_text()), args.iface, args.daq_samples, result, args.limit_fifo,
+                    Path(args.secret_file).read_bytes())
     except Exception as e:   # the session's record says where it stopped; the test shows it
         result["failed"] = f"{type(e).__name__}: {e}"
         raise

@@ -17,8 +17,29 @@
  * command: ERR_CMD_UNKNOWN. A command before CONNECT is ignored (no
  * response), as the standard says; a command frame shorter than its
  * parameters: ERR_CMD_SYNTAX. Upload and download at most 7 / 6 bytes a
- * command (no block mode), address granularity BYTE, Intel byte order,
- * no seed & key (the tool is trusted to be on the bus: see README).
+ * command (no block mode), address granularity BYTE, Intel byte order.
+ *
+ * Seed & key (GET_SEED, UNLOCK; DESIGN 17): with the integrator's random
+ * and key hooks in the config, CAL/PAG is protected (DOWNLOAD, SET_CAL_PAGE,
+ * GET_CAL_PAGE, COPY_CAL_PAGE, GET_PAG_PROCESSOR_INFO answer
+ * ERR_ACCESS_LOCKED while locked), and DAQ (every DAQ command) too when
+ * config.protect_daq; UPLOAD, SHORT_UPLOAD, BUILD_CHECKSUM and GET_ID stay
+ * open (measurement reads). Both hooks NULL: nothing protected (a trusted
+ * bus, as before). CONNECT's RESOURCE byte gives the resources available,
+ * GET_STATUS's second byte the ones still locked (the standard's layouts).
+ * GET_SEED mode 0 (first part) with one resource bit: a new seed of
+ * config.seed_bytes from the random hook (false: ERR_RESOURCE_TEMPORARY_
+ * NOT_ACCESSIBLE), length 0 when that resource is not locked; seed and key
+ * fit one frame each (at most WC_XCP_SEED_MAX_BYTES / WC_XCP_KEY_MAX_BYTES),
+ * so mode 1 (remaining part) is ERR_SEQUENCE. UNLOCK without a seed:
+ * ERR_SEQUENCE; every UNLOCK consumes the seed; a key other than the key
+ * hook's (or of another length): ERR_ACCESS_LOCKED and the session
+ * disconnected, as the standard says. DISCONNECT (and a wrong key) restores
+ * the protection. The library hand-rolls no cryptography.
+ *
+ * Build option WC_XCP_READ_ONLY (a production build): DOWNLOAD,
+ * SET_CAL_PAGE and COPY_CAL_PAGE are removed (ERR_CMD_UNKNOWN); the
+ * controller stays on the page it started on.
  *
  * Memory the master may touch (anything else: ERR_ACCESS_DENIED; a write
  * to a read-only region: ERR_WRITE_PROTECTED), addresses with extension 0:
@@ -83,6 +104,8 @@
 #define WC_XCP_TX_FRAMES (3u + WC_XCP_DAQ_FRAMES_PER_STEP)
 #define WC_XCP_CHECKSUM_MAX_BYTES 4096u  /* BUILD_CHECKSUM block size limit (a step's bounded cost) */
 #define WC_XCP_ID_BYTES 96u
+#define WC_XCP_SEED_MAX_BYTES 6u         /* one GET_SEED response (MAX_CTO - 2) */
+#define WC_XCP_KEY_MAX_BYTES 6u          /* one UNLOCK command (MAX_CTO - 2) */
 
 /* Command codes (ASAM XCP part 2). */
 enum {
@@ -94,17 +117,23 @@ enum {
     WC_XCP_SET_DAQ_LIST_MODE = 0xE0, WC_XCP_START_STOP_DAQ_LIST = 0xDE, WC_XCP_START_STOP_SYNCH = 0xDD,
     WC_XCP_GET_DAQ_CLOCK = 0xDC, WC_XCP_GET_DAQ_PROCESSOR_INFO = 0xDA, WC_XCP_GET_DAQ_RESOLUTION_INFO = 0xD9,
     WC_XCP_GET_DAQ_EVENT_INFO = 0xD7, WC_XCP_FREE_DAQ = 0xD6, WC_XCP_ALLOC_DAQ = 0xD5, WC_XCP_ALLOC_ODT = 0xD4,
-    WC_XCP_ALLOC_ODT_ENTRY = 0xD3
+    WC_XCP_ALLOC_ODT_ENTRY = 0xD3, WC_XCP_GET_SEED = 0xF8, WC_XCP_UNLOCK = 0xF7
 };
+
+/* Resource bits (CONNECT's RESOURCE, GET_STATUS's protection status, GET_SEED's resource). */
+enum { WC_XCP_RESOURCE_CAL_PAG = 0x01, WC_XCP_RESOURCE_DAQ = 0x04, WC_XCP_RESOURCE_STIM = 0x08,
+       WC_XCP_RESOURCE_PGM = 0x10 };
 
 /* Packet identifiers and error codes (ASAM XCP part 2). */
 enum {
     WC_XCP_PID_RES = 0xFF, WC_XCP_PID_ERR = 0xFE, WC_XCP_PID_EV = 0xFD,
     WC_XCP_ERR_CMD_SYNCH = 0x00, WC_XCP_ERR_CMD_BUSY = 0x10, WC_XCP_ERR_DAQ_ACTIVE = 0x11,
     WC_XCP_ERR_CMD_UNKNOWN = 0x20, WC_XCP_ERR_CMD_SYNTAX = 0x21, WC_XCP_ERR_OUT_OF_RANGE = 0x22,
-    WC_XCP_ERR_WRITE_PROTECTED = 0x23, WC_XCP_ERR_ACCESS_DENIED = 0x24, WC_XCP_ERR_PAGE_NOT_VALID = 0x26,
+    WC_XCP_ERR_WRITE_PROTECTED = 0x23, WC_XCP_ERR_ACCESS_DENIED = 0x24, WC_XCP_ERR_ACCESS_LOCKED = 0x25,
+    WC_XCP_ERR_PAGE_NOT_VALID = 0x26,
     WC_XCP_ERR_MODE_NOT_VALID = 0x27, WC_XCP_ERR_SEGMENT_NOT_VALID = 0x28, WC_XCP_ERR_SEQUENCE = 0x29,
     WC_XCP_ERR_DAQ_CONFIG = 0x2A, WC_XCP_ERR_MEMORY_OVERFLOW = 0x30,
+    WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE = 0x33,
     WC_XCP_EV_DAQ_OVERLOAD = 0x06, WC_XCP_EV_USER = 0xFE
 };
 
@@ -118,7 +147,8 @@ typedef struct {
 } wc_xcp_region_t;
 
 /* The slave's configuration: the region bases (on a host: offsets of a
- * virtual address space; WC_XCP_CONFIG_DEFAULT), the identification. */
+ * virtual address space; WC_XCP_CONFIG_DEFAULT), the identification, the
+ * seed & key hooks (as wc_uds.h's). */
 typedef struct {
     uint32_t cal_base;
     uint32_t loop_base;
@@ -126,9 +156,19 @@ typedef struct {
     uint32_t id_base;
     const char *ident;        /* GET_ID type 0 (ASCII), at most WC_XCP_ID_BYTES / 2 */
     const char *a2l_name;     /* GET_ID type 1 (A2L file name without path and extension) */
+    bool protect_daq;         /* with the hooks: DAQ locked too (CAL/PAG always) */
+    uint32_t seed_bytes;      /* 1..WC_XCP_SEED_MAX_BYTES (with the hooks) */
+    uint32_t key_bytes;       /* 1..WC_XCP_KEY_MAX_BYTES (with the hooks) */
+    /* the integrator's hooks, called with context; both NULL: nothing protected, one NULL: init fails */
+    bool (*random)(void *context, uint8_t *seed, uint32_t seed_length);
+    bool (*key)(void *context, const uint8_t *seed, uint32_t seed_length, uint8_t *key, uint32_t key_length);
+    void *context;
 } wc_xcp_config_t;
 
-#define WC_XCP_CONFIG_DEFAULT { 0x00010000u, 0x00100000u, 0x00200000u, 0x00300000u, "wetclutch TCU", "wetclutch" }
+/* Unprotected (no hooks); 6-byte seed and key once hooks are set. */
+#define WC_XCP_CONFIG_DEFAULT                                                                          \
+    { 0x00010000u, 0x00100000u, 0x00200000u, 0x00300000u, "wetclutch TCU", "wetclutch", false, 6u, 6u, \
+      NULL, NULL, NULL }
 
 /* What the master can read of the slave (UPLOAD, DAQ): the counters and the
  * last page check. */
@@ -180,6 +220,9 @@ typedef struct {
     volatile uint32_t rx_head;      /* written only by wc_xcp_step */
     volatile uint32_t rx_tail;      /* written only by wc_xcp_receive */
     bool connected;
+    uint8_t locked;                 /* resource bits still protected (GET_STATUS) */
+    uint8_t seed_resource;          /* the resource of the seed sent; 0: no seed waits for its key */
+    uint8_t seed[WC_XCP_SEED_MAX_BYTES];
     uint32_t mta;                   /* memory transfer address */
     /* DAQ */
     wc_xcp_daq_list_t lists[WC_XCP_DAQ_LISTS];
@@ -198,9 +241,11 @@ typedef struct {
 
 /* Start disconnected, with the working page a copy of reference_payload
  * (wc_cal_image_payload_bytes bytes: the image the loop was initialised
- * from, wc_cal_image.h) and the controller on it. loop must be initialised
- * (wc_loop_init) from that same calibration. Returns false (slave unusable)
- * on a NULL argument or a reference that does not decode. */
+ * from, wc_cal_image.h) and the controller on it, protected resources
+ * locked. loop must be initialised (wc_loop_init) from that same
+ * calibration. Returns false (slave unusable) on a NULL argument, a
+ * reference that does not decode, one hook without the other, or a seed or
+ * key length out of range. */
 bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payload, const wc_xcp_config_t *config);
 
 /* Queue one frame of the XcpCommand id (the port filters by id). Returns

@@ -41,6 +41,8 @@ WC_STATIC_ASSERT(WC_XCP_ODT_ENTRIES <= 0xFFu, xcp_entries_fit_a_byte);
 WC_STATIC_ASSERT(WC_XCP_DAQ_LISTS <= 0xFFu, xcp_lists_fit_a_byte);
 WC_STATIC_ASSERT(ID_EVENT + sizeof event_name <= WC_XCP_ID_BYTES, xcp_id_texts_fit);
 WC_STATIC_ASSERT(WC_CAN_XCP_RESPONSE_LENGTH == MAX_DTO, xcp_response_is_a_classic_can_frame);
+WC_STATIC_ASSERT(WC_XCP_SEED_MAX_BYTES <= MAX_CTO - 2u, xcp_seed_fits_one_response);
+WC_STATIC_ASSERT(WC_XCP_KEY_MAX_BYTES <= MAX_CTO - 2u, xcp_key_fits_one_unlock);
 
 static void put16(uint8_t *dst, uint32_t value)
 {
@@ -57,6 +59,7 @@ static void copy_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
     for (uint32_t i = 0u; i < length; ++i) { dst[i] = src[i]; }
 }
 
+#ifndef WC_XCP_READ_ONLY
 /* The same into the working page: returns whether any byte changed (a
  * page written with the bytes it holds needs no check). */
 static bool write_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
@@ -68,6 +71,7 @@ static bool write_bytes(uint8_t *dst, const uint8_t *src, uint32_t length)
     }
     return changed;
 }
+#endif
 
 /* Copies text (at most capacity - 1 characters) to dst, NUL-terminated; returns its length. */
 static uint32_t copy_text(char *dst, const char *text, uint32_t capacity)
@@ -120,13 +124,27 @@ static uint32_t resolve(wc_xcp_t *x, uint32_t address, uint32_t extension, uint3
     return WC_XCP_ERR_ACCESS_DENIED;
 }
 
+/* The resources seed & key protects under config (both hooks set). */
+static uint8_t protected_resources(const wc_xcp_config_t *config)
+{
+    if ((config->random == NULL) || (config->key == NULL)) { return 0u; }
+    return (uint8_t)(WC_XCP_RESOURCE_CAL_PAG | (config->protect_daq ? WC_XCP_RESOURCE_DAQ : 0u));
+}
+
 bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payload, const wc_xcp_config_t *config)
 {
     WC_ASSERT((xcp != NULL) && (loop != NULL) && (reference_payload != NULL) && (config != NULL));
     if ((xcp == NULL) || (loop == NULL) || (reference_payload == NULL) || (config == NULL)) { return false; }
     memset(xcp, 0, sizeof *xcp);
     if (wc_cal_image_payload_bytes > WC_CAL_IMAGE_PAYLOAD_MAX_BYTES) { return false; }
+    if ((config->random == NULL) != (config->key == NULL)) { return false; }  /* half a protection: none */
+    if ((config->random != NULL) &&
+        ((config->seed_bytes == 0u) || (config->seed_bytes > WC_XCP_SEED_MAX_BYTES) || (config->key_bytes == 0u) ||
+         (config->key_bytes > WC_XCP_KEY_MAX_BYTES))) {
+        return false;
+    }
     xcp->config = *config;
+    xcp->locked = protected_resources(config);
     xcp->loop = loop;
     xcp->reference_page = reference_payload;
     copy_bytes(xcp->working_page, reference_payload, wc_cal_image_payload_bytes);
@@ -404,6 +422,7 @@ static bool check_page(wc_xcp_t *x, wc_can_frame_t *event)
     return true;
 }
 
+#ifndef WC_XCP_READ_ONLY
 static uint32_t set_cal_page(wc_xcp_t *x, const uint8_t *cmd)
 {
     const uint32_t mode = cmd[1];
@@ -419,6 +438,7 @@ static uint32_t set_cal_page(wc_xcp_t *x, const uint8_t *cmd)
     }
     return XCP_OK;
 }
+#endif
 
 static uint32_t get_cal_page(const wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
 {
@@ -428,6 +448,7 @@ static uint32_t get_cal_page(const wc_xcp_t *x, const uint8_t *cmd, uint8_t *res
     return XCP_OK;
 }
 
+#ifndef WC_XCP_READ_ONLY
 static uint32_t copy_cal_page(wc_xcp_t *x, const uint8_t *cmd)
 {
     if ((cmd[1] != 0u) || (cmd[3] != 0u)) { return WC_XCP_ERR_SEGMENT_NOT_VALID; }
@@ -439,6 +460,7 @@ static uint32_t copy_cal_page(wc_xcp_t *x, const uint8_t *cmd)
     }
     return XCP_OK;
 }
+#endif
 
 /* ------------------------------------------------------------ memory access */
 
@@ -453,6 +475,7 @@ static uint32_t upload(wc_xcp_t *x, uint32_t address, uint32_t extension, uint32
     return XCP_OK;
 }
 
+#ifndef WC_XCP_READ_ONLY
 static uint32_t download(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc)
 {
     const uint32_t length = cmd[1];
@@ -467,6 +490,7 @@ static uint32_t download(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc)
     x->mta += length;
     return XCP_OK;
 }
+#endif
 
 static uint32_t build_checksum(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
 {
@@ -536,21 +560,101 @@ static uint32_t daq_event_info(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
     return XCP_OK;
 }
 
+/* ------------------------------------------------------------ seed & key */
+
+/* Protection back on, no seed waiting: at DISCONNECT and after a wrong key. */
+static void relock(wc_xcp_t *x)
+{
+    x->locked = protected_resources(&x->config);
+    x->seed_resource = 0u;
+    memset(x->seed, 0, sizeof x->seed);
+}
+
+static uint32_t get_seed(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
+{
+    const uint32_t mode = cmd[1];
+    const uint32_t resource = cmd[2];
+    if (mode == 1u) { return WC_XCP_ERR_SEQUENCE; }  /* the seed fits one response: no remaining part */
+    if (mode != 0u) { return WC_XCP_ERR_OUT_OF_RANGE; }
+    if ((resource != WC_XCP_RESOURCE_CAL_PAG) && (resource != WC_XCP_RESOURCE_DAQ) &&
+        (resource != WC_XCP_RESOURCE_STIM) && (resource != WC_XCP_RESOURCE_PGM)) {
+        return WC_XCP_ERR_OUT_OF_RANGE;  /* exactly one resource a seed */
+    }
+    x->seed_resource = 0u;  /* a new request forgets the old seed */
+    if ((x->locked & resource) == 0u) {
+        res[1] = 0u;  /* not protected (or unlocked already): seed length 0 */
+        return XCP_OK;
+    }
+    const uint32_t length = x->config.seed_bytes;
+    if (!x->config.random(x->config.context, x->seed, length)) { return WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE; }
+    x->seed_resource = (uint8_t)resource;
+    res[1] = (uint8_t)length;
+    copy_bytes(&res[2], x->seed, length);
+    return XCP_OK;
+}
+
+static uint32_t unlock(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc, uint8_t *res)
+{
+    const uint32_t length = cmd[1];
+    if ((length <= WC_XCP_KEY_MAX_BYTES) && (dlc < 2u + length)) { return WC_XCP_ERR_CMD_SYNTAX; }
+    if (x->seed_resource == 0u) { return WC_XCP_ERR_SEQUENCE; }
+    const uint8_t resource = x->seed_resource;
+    x->seed_resource = 0u;  /* every UNLOCK consumes the seed */
+    uint8_t expected[WC_XCP_KEY_MAX_BYTES] = { 0u };
+    const uint32_t key_length = x->config.key_bytes;
+    bool good = (length == key_length) &&
+                x->config.key(x->config.context, x->seed, x->config.seed_bytes, expected, key_length);
+    uint32_t difference = 0u;  /* every byte compared: the time says nothing of the first wrong one */
+    for (uint32_t i = 0u; i < WC_XCP_KEY_MAX_BYTES; ++i) {
+        difference |= (i < key_length) ? (uint32_t)(expected[i] ^ cmd[2u + i]) : 0u;
+    }
+    good = good && (difference == 0u);
+    memset(expected, 0, sizeof expected);
+    if (!good) {  /* the standard: ERR_ACCESS_LOCKED and back to disconnected */
+        daq_stop_all(x);
+        x->connected = false;
+        relock(x);
+        return WC_XCP_ERR_ACCESS_LOCKED;
+    }
+    x->locked &= (uint8_t)~resource;
+    res[1] = x->locked;  /* the current resource protection status */
+    return XCP_OK;
+}
+
+/* The resource a command needs unlocked (0: none). */
+static uint32_t resource_of(uint32_t code)
+{
+    switch (code) {
+    case WC_XCP_DOWNLOAD: case WC_XCP_SET_CAL_PAGE: case WC_XCP_GET_CAL_PAGE: case WC_XCP_COPY_CAL_PAGE:
+    case WC_XCP_GET_PAG_PROCESSOR_INFO: return WC_XCP_RESOURCE_CAL_PAG;
+    case WC_XCP_GET_DAQ_PROCESSOR_INFO: case WC_XCP_GET_DAQ_RESOLUTION_INFO: case WC_XCP_GET_DAQ_EVENT_INFO:
+    case WC_XCP_GET_DAQ_CLOCK: case WC_XCP_FREE_DAQ: case WC_XCP_ALLOC_DAQ: case WC_XCP_ALLOC_ODT:
+    case WC_XCP_ALLOC_ODT_ENTRY: case WC_XCP_SET_DAQ_PTR: case WC_XCP_WRITE_DAQ: case WC_XCP_SET_DAQ_LIST_MODE:
+    case WC_XCP_START_STOP_DAQ_LIST: case WC_XCP_START_STOP_SYNCH: return WC_XCP_RESOURCE_DAQ;
+    default: return 0u;
+    }
+}
+
 /* --------------------------------------------------------------- commands */
 
 /* Bytes each command needs (its code included); 0: not supported. */
 static uint32_t command_length(uint32_t code)
 {
     switch (code) {
-    case WC_XCP_CONNECT: case WC_XCP_UPLOAD: case WC_XCP_START_STOP_SYNCH: case WC_XCP_DOWNLOAD: return 2u;
+    case WC_XCP_CONNECT: case WC_XCP_UPLOAD: case WC_XCP_START_STOP_SYNCH: case WC_XCP_UNLOCK: return 2u;
+#ifndef WC_XCP_READ_ONLY
+    case WC_XCP_DOWNLOAD: return 2u;
+    case WC_XCP_SET_CAL_PAGE: return 4u;
+    case WC_XCP_COPY_CAL_PAGE: return 5u;
+#endif
     case WC_XCP_DISCONNECT: case WC_XCP_GET_STATUS: case WC_XCP_SYNCH: case WC_XCP_GET_COMM_MODE_INFO:
     case WC_XCP_GET_PAG_PROCESSOR_INFO: case WC_XCP_GET_DAQ_CLOCK: case WC_XCP_GET_DAQ_PROCESSOR_INFO:
     case WC_XCP_GET_DAQ_RESOLUTION_INFO: case WC_XCP_FREE_DAQ: return 1u;
     case WC_XCP_GET_ID: return 2u;
-    case WC_XCP_GET_CAL_PAGE: return 3u;
-    case WC_XCP_SET_CAL_PAGE: case WC_XCP_ALLOC_DAQ: case WC_XCP_START_STOP_DAQ_LIST:
+    case WC_XCP_GET_CAL_PAGE: case WC_XCP_GET_SEED: return 3u;
+    case WC_XCP_ALLOC_DAQ: case WC_XCP_START_STOP_DAQ_LIST:
     case WC_XCP_GET_DAQ_EVENT_INFO: return 4u;
-    case WC_XCP_COPY_CAL_PAGE: case WC_XCP_ALLOC_ODT: return 5u;
+    case WC_XCP_ALLOC_ODT: return 5u;
     case WC_XCP_ALLOC_ODT_ENTRY: case WC_XCP_SET_DAQ_PTR: return 6u;
     case WC_XCP_SET_MTA: case WC_XCP_SHORT_UPLOAD: case WC_XCP_BUILD_CHECKSUM: case WC_XCP_WRITE_DAQ:
     case WC_XCP_SET_DAQ_LIST_MODE: return 8u;
@@ -570,8 +674,13 @@ static uint32_t dispatch(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc, uint8_t 
         res[6] = 1u;             /* protocol layer version */
         res[7] = 1u;             /* transport layer version */
         return XCP_OK;
-    case WC_XCP_DISCONNECT: daq_stop_all(x); x->connected = false; return XCP_OK;
-    case WC_XCP_GET_STATUS: res[1] = x->daq_running ? SESSION_DAQ_RUNNING : 0u; return XCP_OK;
+    case WC_XCP_DISCONNECT: daq_stop_all(x); x->connected = false; relock(x); return XCP_OK;
+    case WC_XCP_GET_STATUS:
+        res[1] = x->daq_running ? SESSION_DAQ_RUNNING : 0u;
+        res[2] = x->locked;  /* resource protection status */
+        return XCP_OK;
+    case WC_XCP_GET_SEED: return get_seed(x, cmd, res);
+    case WC_XCP_UNLOCK: return unlock(x, cmd, dlc, res);
     case WC_XCP_SYNCH: return WC_XCP_ERR_CMD_SYNCH;
     case WC_XCP_GET_COMM_MODE_INFO: res[7] = 0x10u; return XCP_OK;  /* no block modes, driver version 1.0 */
     case WC_XCP_GET_ID: return get_id(x, cmd, res);
@@ -581,12 +690,14 @@ static uint32_t dispatch(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc, uint8_t 
         return XCP_OK;
     case WC_XCP_UPLOAD: return upload(x, x->mta, 0u, cmd[1], res);
     case WC_XCP_SHORT_UPLOAD: return upload(x, wc_image_get_u32(&cmd[4]), cmd[3], cmd[1], res);
+#ifndef WC_XCP_READ_ONLY
     case WC_XCP_DOWNLOAD: return download(x, cmd, dlc);
-    case WC_XCP_BUILD_CHECKSUM: return build_checksum(x, cmd, res);
     case WC_XCP_SET_CAL_PAGE: return set_cal_page(x, cmd);
+    case WC_XCP_COPY_CAL_PAGE: return copy_cal_page(x, cmd);
+#endif
+    case WC_XCP_BUILD_CHECKSUM: return build_checksum(x, cmd, res);
     case WC_XCP_GET_CAL_PAGE: return get_cal_page(x, cmd, res);
     case WC_XCP_GET_PAG_PROCESSOR_INFO: res[1] = 1u; return XCP_OK;  /* one segment, no freeze */
-    case WC_XCP_COPY_CAL_PAGE: return copy_cal_page(x, cmd);
     case WC_XCP_GET_DAQ_PROCESSOR_INFO: daq_processor_info(res); return XCP_OK;
     case WC_XCP_GET_DAQ_RESOLUTION_INFO: daq_resolution_info(x, res); return XCP_OK;
     case WC_XCP_GET_DAQ_EVENT_INFO: return daq_event_info(x, cmd, res);
@@ -618,7 +729,11 @@ static bool command(wc_xcp_t *x, const wc_can_frame_t *in, wc_can_frame_t *res)
     uint8_t cmd[MAX_CTO] = { 0u };
     copy_bytes(cmd, in->data, in->dlc);  /* bytes past the DLC read as 0, never as old data */
     uint32_t result = WC_XCP_ERR_CMD_UNKNOWN;
-    if (needed != 0u) { result = (in->dlc < needed) ? WC_XCP_ERR_CMD_SYNTAX : dispatch(x, cmd, in->dlc, res->data); }
+    if (needed != 0u) {
+        if (in->dlc < needed) { result = WC_XCP_ERR_CMD_SYNTAX; }
+        else if ((x->locked & resource_of(cmd[0])) != 0u) { result = WC_XCP_ERR_ACCESS_LOCKED; }  /* seed & key first */
+        else { result = dispatch(x, cmd, in->dlc, res->data); }
+    }
     x->status.commands++;
     if (result != XCP_OK) {
         const uint8_t max_block[4] = { res->data[4], res->data[5], res->data[6], res->data[7] };

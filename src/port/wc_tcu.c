@@ -136,8 +136,9 @@ static void usage(FILE *out)
             "      --uds                 UDS diagnostics over ISO-TP (UdsPhysicalRequest 0x7E1, UdsFunctionalRequest\n"
             "                            0x7DF, UdsResponse 0x7E9): identity, DIDs, DTCs, SecurityAccess, adaptation\n"
             "                            reset routine; after the step's control frames, one frame a step by default\n"
-            "      --secret-file FILE    with --uds (required): the device secret (16..1024 bytes); the key of a\n"
-            "                            seed is HMAC-SHA256(secret, seed), its first 16 bytes\n"
+            "      --secret-file FILE    with --uds (required) or --xcp: the device secret (16..1024 bytes); the key\n"
+            "                            of a seed is HMAC-SHA256(secret, seed), its first 16 bytes (UDS) or 6 bytes\n"
+            "                            (XCP GET_SEED/UNLOCK: CAL/PAG locked until then; without it XCP is open)\n"
             "      --dtc-file FILE       with --uds: the fault memory's image, read at start (missing: empty;\n"
             "                            corrupt: empty and DTC 0x062F00) and written atomically on change and at exit\n"
             "      --serial TEXT         with --uds: the ECU serial number (DID 0xF18C; default WC0000000001)\n"
@@ -249,8 +250,12 @@ static int parse_options(int argc, char **argv, options_t *o)
         }
     }
     if (optind < argc) { fprintf(stderr, "wc_tcu: unexpected argument '%s'\n", argv[optind]); return -1; }
-    if (!o->uds && ((o->secret_file != NULL) || (o->dtc_file != NULL) || (o->serial != NULL))) {
-        fprintf(stderr, "wc_tcu: --secret-file, --dtc-file and --serial need --uds\n");
+    if (!o->uds && ((o->dtc_file != NULL) || (o->serial != NULL))) {
+        fprintf(stderr, "wc_tcu: --dtc-file and --serial need --uds\n");
+        return -1;
+    }
+    if (!o->uds && !o->xcp && (o->secret_file != NULL)) {
+        fprintf(stderr, "wc_tcu: --secret-file needs --uds or --xcp\n");
         return -1;
     }
     if (o->uds && (o->secret_file == NULL)) {
@@ -316,12 +321,26 @@ static const wc_calibration_t *find_calibration(const char *name)
 }
 
 /* --xcp: the slave over the loop, its reference page the loop's calibration
- * encoded as an image payload (the same bytes an image file holds). */
-static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config)
+ * encoded as an image payload (the same bytes an image file holds); with a
+ * secret file, CAL/PAG behind seed & key, else open (said on stderr). */
+static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
+                     const char *secret_file)
 {
     static wc_cal_set_t set;
     static uint8_t reference[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
-    const wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
+    static wc_device_secret_t secret;   /* XCP seed & key: the device secret of UDS SecurityAccess */
+    wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
+    if (secret_file != NULL) {
+        if (wc_device_secret_read(&secret, secret_file, "wc_tcu") != 0) { return -1; }
+        xcp_config.seed_bytes = WC_XCP_SEED_MAX_BYTES;
+        xcp_config.key_bytes = WC_XCP_KEY_MAX_BYTES;
+        xcp_config.random = wc_device_secret_random;   /* the key: HMAC-SHA256(secret, seed), its first bytes */
+        xcp_config.key = wc_device_secret_key;
+        xcp_config.context = &secret;
+    } else {
+        fprintf(stderr, "wc_tcu: warning: --xcp without --secret-file: calibration writes are not protected"
+                        " (no XCP seed & key)\n");
+    }
     if (!wc_cal_set_from(&set, cal, config->shift, config)) {
         fprintf(stderr, "wc_tcu: --xcp: the calibration does not fit a calibration page\n");
         return -1;
@@ -551,7 +570,7 @@ int main(int argc, char **argv)
 
     /* The XCP slave: its reference page is the calibration the loop started with, as an image payload. */
     static wc_xcp_t xcp;
-    if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config) != 0)) { return 2; }
+    if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config, opt.secret_file) != 0)) { return 2; }
 
     /* The diagnostic server: the calibration image the loop runs (its CRC is a DID), the fault memory. */
     static wc_tcu_diag_t diag;

@@ -1,6 +1,7 @@
 /* wc_tcu --uds: the diagnostic server over the frame loop (wc_tcu_diag.h). */
 #define _GNU_SOURCE
 #include "wc_tcu_diag.h"
+#include "wc_device_secret.h"
 
 #include <errno.h>
 #include <math.h>
@@ -191,62 +192,22 @@ static uint8_t reset_results(void *context, const uint8_t *option, uint32_t opti
 
 /* ---- security hooks: getrandom(2) and HMAC-SHA256 (OpenSSL) -------------------------------------------- */
 
-static bool random_seed(void *context, uint8_t *seed, uint32_t length)
-{
-    (void)context;
-    size_t done = 0u;
-    for (int tries = 0; (done < length) && (tries < 16); ++tries) {
-        const ssize_t n = getrandom(seed + done, length - done, 0);
-        if (n > 0) { done += (size_t)n; }
-        else if (errno != EINTR) { break; }
-    }
-    return done == length;  /* false: 0x22, never a predictable seed */
-}
-
 static bool key_of_seed(void *context, const uint8_t *seed, uint32_t seed_length, uint8_t *key, uint32_t key_length)
 {
     const wc_tcu_diag_t *d = context;
-    uint8_t mac[EVP_MAX_MD_SIZE];
-    unsigned int mac_length = 0u;
-    if (HMAC(EVP_sha256(), d->secret, (int)d->secret_bytes, seed, seed_length, mac, &mac_length) == NULL ||
-        (mac_length < key_length)) {
-        return false;
-    }
-    memcpy(key, mac, key_length);
-    return true;
+    return wc_device_secret_key((void *)&d->secret, seed, seed_length, key, key_length);
 }
 
 /* ---- files ---------------------------------------------------------------------------------------------- */
 
 static int read_secret(wc_tcu_diag_t *d)
 {
-    const char *path = d->options.secret_file;
-    if (path == NULL) {
+    if (d->options.secret_file == NULL) {
         fprintf(stderr, "%s: --uds needs --secret-file PATH (the device secret of the security access key)\n",
                 d->options.program);
         return -1;
     }
-    FILE *f = fopen(path, "rb");
-    if (f == NULL) {
-        fprintf(stderr, "%s: --secret-file %s: %s\n", d->options.program, path, strerror(errno));
-        return -1;
-    }
-    uint8_t extra = 0u;
-    d->secret_bytes = fread(d->secret, 1u, sizeof d->secret, f);
-    const int error = ferror(f) ? errno : 0;
-    const bool longer = (d->secret_bytes == sizeof d->secret) && (fread(&extra, 1u, 1u, f) == 1u);
-    fclose(f);
-    if (error != 0) {
-        fprintf(stderr, "%s: --secret-file %s: %s\n", d->options.program, path, strerror(error));
-        return -1;
-    }
-    if ((d->secret_bytes < 16u) || longer) {
-        fprintf(stderr, "%s: --secret-file %s: %zu bytes; the device secret must be 16..%u bytes\n",
-                d->options.program, path, longer ? sizeof d->secret + 1u : d->secret_bytes,
-                WC_TCU_DIAG_SECRET_MAX_BYTES);
-        return -1;
-    }
-    return 0;
+    return wc_device_secret_read(&d->secret, d->options.secret_file, d->options.program);
 }
 
 static void store_dtc(wc_tcu_diag_t *d)
@@ -352,7 +313,7 @@ int wc_tcu_diag_open(wc_tcu_diag_t *d, const wc_tcu_diag_options_t *options, wc_
     u->routines = d->routines;
     u->routine_count = 1u;
     u->dtc = &d->dtc;
-    u->random = random_seed;
+    u->random = wc_device_secret_random;
     u->key = key_of_seed;
     u->context = d;
     if (!wc_uds_init(&d->uds, u)) {

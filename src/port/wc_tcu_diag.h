@@ -44,9 +44,9 @@
 #include "wetclutch_can/wc_loop.h"
 #include "wetclutch_can/wc_uds.h"
 #include "wetclutch_can/wc_xcp.h"
+#include "wc_device_secret.h"
 
 #define WC_TCU_SOFTWARE_VERSION "wetclutch 0.1.0"
-#define WC_TCU_DIAG_SECRET_MAX_BYTES 1024u
 #define WC_TCU_DIAG_SERIAL_MAX_BYTES 32u
 #define WC_TCU_DIAG_TX_FRAMES WC_ISOTP_MAX_FRAMES_PER_STEP
 #define WC_TCU_DIAG_DIDS 7u
@@ -72,8 +72,7 @@ typedef struct {
     wc_uds_routine_t routines[1];
     wc_dtc_t dtc;
     wc_dtc_snapshot_t environment;    /* the operating point, refreshed each step */
-    uint8_t secret[WC_TCU_DIAG_SECRET_MAX_BYTES];
-    size_t secret_bytes;
+    wc_device_secret_t secret;        /* the key of SecurityAccess (wc_device_secret.h) */
     char serial[WC_TCU_DIAG_SERIAL_MAX_BYTES + 1u];
     uint32_t cal_image_crc32;
     uint32_t cal_layout_version;

@@ -624,7 +624,7 @@ static void test_command_errors(void **state)
     connect();
     EXPECT_ERR(CMD(0xC0), WC_XCP_ERR_CMD_UNKNOWN);               /* not an XCP command */
     EXPECT_ERR(CMD(0xF1, 0, 0, 0, 0, 0, 0, 0), WC_XCP_ERR_CMD_UNKNOWN);  /* USER_CMD: not supported */
-    EXPECT_ERR(CMD(0xF8, 0, 0), WC_XCP_ERR_CMD_UNKNOWN);                 /* GET_SEED: no seed & key */
+    EXPECT_ERR(CMD(0xF8, 0, 0), WC_XCP_ERR_OUT_OF_RANGE);  /* GET_SEED of no resource (test_xcp_security.c) */
     EXPECT_ERR(command(BYTES(WC_XCP_SET_MTA, 0, 0, 0), 4u), WC_XCP_ERR_CMD_SYNTAX);  /* too short */
     EXPECT_ERR(command(BYTES(WC_XCP_GET_ID), 1u), WC_XCP_ERR_CMD_SYNTAX);
     EXPECT_ERR(command(BYTES(WC_XCP_DOWNLOAD, 4, 1, 2), 4u), WC_XCP_ERR_CMD_SYNTAX);  /* 4 bytes announced, 2 sent */

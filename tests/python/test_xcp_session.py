@@ -70,6 +70,19 @@ def test_connect_identity_and_checksum(session):
     assert r["checksum"] == zlib.crc32(payload)
 
 
+def test_download_refused_until_seed_and_key(session):
+    """wc_tcu --secret-file: CAL/PAG locked at connect, a DOWNLOAD refused with ERR_ACCESS_LOCKED (0x25),
+    then unlocked by pyxcp's seed & key (cond_unlock, the key HMAC-SHA256(secret, seed) computed in Python):
+    one seed of 6 bytes for CAL/PAG (resource 0x01); DAQ never locked."""
+    work, r, _ = session
+    assert r["protection_at_connect"] == {"calpag": True, "daq": False}
+    assert r["download_before_unlock"] == 0x25
+    assert len(r["unlock_seeds"]) == 1 and r["unlock_seeds"][0][0] == 0x01
+    assert len(bytes.fromhex(r["unlock_seeds"][0][1])) == 6
+    assert r["protection_after_unlock"] == {"calpag": False, "daq": False}
+    assert "warning" not in (work / "tcu.txt").read_text()   # protected: no warning of an open XCP
+
+
 def test_every_characteristic_reads_back_the_image(session):
     _, r, _ = session
     assert r["characteristics_read"] == len(image_layout.FIELDS)
@@ -141,7 +154,9 @@ def test_error_packets_for_bad_commands(session):
     assert raw["before_connect"] == [] and raw["empty"] == [] and raw["remote_frame"] == []
     assert raw["connect"][0].startswith("ff05")
     assert raw["unknown_command"] == ["fe20000000000000"]
-    assert raw["short_set_mta"] == ["fe21000000000000"] and raw["download_dlc_short"] == ["fe21000000000000"]
+    assert raw["short_set_mta"] == ["fe21000000000000"]
+    # the raw session connects after pyxcp's DISCONNECT: CAL/PAG locked again, any DOWNLOAD ERR_ACCESS_LOCKED
+    assert raw["download_dlc_short"] == ["fe25000000000000"]
     assert raw["upload_zero"] == ["fe22000000000000"] and raw["daq_ptr_unallocated"] == ["fe22000000000000"]
     assert raw["write_daq_without_ptr"] == ["fe29000000000000"]
     assert raw["synch"] == ["fe00000000000000"] and raw["disconnect"] == ["ff00000000000000"]

@@ -1,6 +1,7 @@
 """The host's side of the XCP session against ``wc_tcu --xcp`` (DESIGN 13): the A2L read by pya2ldb, the
 plan the guest's master follows (hil/xcp_master.py: addresses and the bytes the image holds at each
-characteristic), and the run on vcan (hil/xcp_guest.sh through hil/vcan_run.sh)."""
+characteristic), the device secret of the XCP seed & key (wc_tcu --secret-file), and the run on vcan
+(hil/xcp_guest.sh through hil/vcan_run.sh)."""
 from __future__ import annotations
 
 import json
@@ -40,9 +41,20 @@ def write_plan(a2l: Path, image: Path, out: Path) -> dict:
     return plan
 
 
+def write_secret(path: Path, secret_bytes: int = 32) -> bytes:
+    """A fresh device secret (wc_tcu --secret-file: 16..1024 bytes), written owner-only."""
+    secret = os.urandom(secret_bytes)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "wb") as f:
+        f.write(secret)
+    return secret
+
+
 def run_on_vcan(work: Path, tcu: Path, daq_samples: int = 5000) -> int:
-    """hil/xcp_guest.sh on work (input.log, cal.img, plan.json) on vcan: natively, in the serving guest
-    (VCAN_SERVER) or in a guest of its own. Returns its exit code."""
+    """hil/xcp_guest.sh on work (input.log, cal.img, plan.json; secret.bin written here when missing) on
+    vcan: natively, in the serving guest (VCAN_SERVER) or in a guest of its own. Returns its exit code."""
+    if not (Path(work) / "secret.bin").is_file():
+        write_secret(Path(work) / "secret.bin")
     env = dict(os.environ, PATH=f"{ROOT / '.venv' / 'bin'}:{os.environ.get('PATH', '')}")
     cmd = ["bash", str(ROOT / "hil" / "vcan_run.sh"), "--rwdir", str(work), "--", "bash",
            str(ROOT / "hil" / "xcp_guest.sh"), str(work), "--tcu", str(tcu), "--daq-samples", str(daq_samples)]
