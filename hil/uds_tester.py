@@ -88,6 +88,16 @@ def _nrc(call) -> int:
     return 0
 
 
+def _delay_answers(client) -> int:
+    """How many requestSeed were answered requiredTimeDelayNotExpired (0x37) before the delay ended."""
+    answers = 0
+    for _ in range(POLLS):
+        if _nrc(lambda: client.request_seed(1)) != 0x37:
+            break
+        answers += 1
+    return answers
+
+
 def _dtcs(client, mask: int) -> dict:
     response = client.get_dtc_by_status_mask(mask)
     return {d.id: d.status.get_byte_as_int() for d in response.service_data.dtcs}
@@ -118,13 +128,7 @@ def session(client, secret: bytes, result: dict) -> None:
                         "seed_in_default_session": _nrc(lambda: client.request_seed(1))}
     client.change_session(udsoncan.services.DiagnosticSessionControl.Session.extendedDiagnosticSession)
     # the delay after start (a restart buys no attempts): requestSeed answered 0x37 until it ends
-    delay_answers = 0
-    for _ in range(POLLS):
-        code = _nrc(lambda: client.request_seed(1))
-        if code != 0x37:
-            break
-        delay_answers += 1
-    result["delay_at_start_answers"] = delay_answers
+    result["delay_at_start_answers"] = _delay_answers(client)
     seed = bytes(client.request_seed(1).service_data.seed)
     result["seed_bytes"] = len(seed)
     good = hmac.new(secret, seed, hashlib.sha256).digest()[:KEY_BYTES]
@@ -172,13 +176,7 @@ def session(client, secret: bytes, result: dict) -> None:
         wrong.append(_nrc(lambda: client.send_key(2, bytes(KEY_BYTES))))
     result["three_wrong_keys"] = wrong
     result["routine_after_wrong_keys"] = _nrc(lambda: client.start_routine(ADAPTATION_RESET))
-    delay_answers = 0
-    for _ in range(POLLS):
-        code = _nrc(lambda: client.request_seed(1))
-        if code != 0x37:
-            break
-        delay_answers += 1
-    result["delay_answers"] = delay_answers
+    result["delay_answers"] = _delay_answers(client)
     client.unlock_security_access(1)   # udsoncan's own seed & key exchange with security_algo
     result["unlocked_after_delay"] = True
     mark("delay")
