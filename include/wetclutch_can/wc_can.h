@@ -234,6 +234,7 @@ extern "C" {
 #define WC_CAN_SHIFT_REPORT_FLARE_NAME "Flare"
 #define WC_CAN_SHIFT_REPORT_TIE_UP_NAME "TieUp"
 #define WC_CAN_SHIFT_REPORT_ABORT_REASON_NAME "AbortReason"
+#define WC_CAN_SHIFT_REPORT_SATURATED_NAME "Saturated"
 #define WC_CAN_ADAPTATION_REPORT_RESULT_NAME "Result"
 #define WC_CAN_ADAPTATION_REPORT_NODE_NAME "Node"
 #define WC_CAN_ADAPTATION_REPORT_IMAGE_MISSING_NAME "ImageMissing"
@@ -782,6 +783,15 @@ struct wc_can_shift_report_t {
      * Offset: 0
      */
     uint8_t abort_reason;
+
+    /**
+     * 1: a figure of this report (PeakJerk, FrictionEnergy, InertiaPhaseTime, SlipRmse, PeakClutchTemp) exceeded its range and is sent at its limit: the shift was worse than the frame can say.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t saturated;
 };
 
 /**
@@ -2488,6 +2498,28 @@ bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_shift_report_abort_reason_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_saturated_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_report_saturated_is_in_phys_range(float value);
 
 /**
  * Pack message AdaptationReport.

@@ -58,6 +58,7 @@ extern const wc_can_signal_t wc_can_sig_shift_report_friction_energy; /* kJ */
 extern const wc_can_signal_t wc_can_sig_shift_report_peak_clutch_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_shift_report_flare; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_report_tie_up; /* 1 */
+extern const wc_can_signal_t wc_can_sig_shift_report_saturated; /* 1 */
 extern const wc_can_signal_t wc_can_sig_adaptation_report_result; /* 1 */
 extern const wc_can_signal_t wc_can_sig_adaptation_report_node; /* 1 */
 extern const wc_can_signal_t wc_can_sig_adaptation_report_image_missing; /* 1 */
@@ -138,6 +139,7 @@ typedef struct {
     float peak_clutch_temp_degC;
     float flare;
     float tie_up;
+    float saturated;
     uint8_t abort_reason; /**< WC_CAN_SHIFT_REPORT_ABORT_REASON_*_CHOICE */
 } wc_can_shift_report_phys_t;
 

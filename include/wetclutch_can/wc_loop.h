@@ -19,8 +19,8 @@
  *  - wc_loop_init runs before the interrupt that calls wc_loop_receive is
  *    enabled.
  *
- * Safe-state policy (also in README.md, with the reaction and recovery
- * periods):
+ * Safe-state policy (also in docs/integrating.md, with the reaction and
+ * recovery periods):
  *  - A received frame is used only if its length, CRC and alive counter are
  *    right and every signal is plausible (inside its DBC range, not SNA, Mode
  *    not reserved). The alive counter follows AUTOSAR E2E Profile 1
@@ -37,12 +37,18 @@
  *    stale: StatusSensorTimeout or StatusRequestTimeout, and its E2E receiver
  *    restarts. While either control input is stale, and until both have been
  *    fresh for recovery_periods (default 20) in a row, the loop outputs the
- *    safe state, StatusSafeStateActive: the solenoid's minimum current
- *    (clutch released: an element that cannot be controlled is opened; the
- *    transmission's limp-home strategy is the integrator's). The observer
- *    keeps running on the held temperatures with the released clutch. An
- *    input that comes and goes therefore holds the safe state instead of
- *    switching the solenoid.
+ *    safe state, StatusSafeStateActive. Outside the whole shift it is the
+ *    solenoid's minimum current (clutch released: an element that cannot be
+ *    controlled is opened; the transmission's limp-home strategy is the
+ *    integrator's). With the whole shift (DESIGN 14, config.offgoing) the
+ *    safe state is the fallback of the shift's phase, not a release: in IDLE
+ *    and in a hand-back (prepare or torque phase) the off-going clutch holds
+ *    1st gear at its maximum current and the on-coming one is released; from
+ *    the inertia phase on the on-coming clutch finishes on the model and
+ *    holds 2nd gear for at most fallback_time_s, then both are released
+ *    (OffgoingVfsCommand.Fallback says which; wc_shift.h). The observer keeps
+ *    running on the held temperatures. An input that comes and goes
+ *    therefore holds the safe state instead of switching the solenoid.
  *  - Before the inputs have been fresh for recovery_periods after init, the
  *    loop is in the safe state.
  *  - BenchMeasurement (bench only, no E2E) is used only when
@@ -237,11 +243,18 @@ void wc_loop_port_event(wc_loop_t *loop, wc_loop_port_event_t event, uint32_t co
  * a third control input (E2E, timeout request_timeout_periods, counted as a
  * request timeout: StatusRequestTimeout) and the safe state applies to it
  * like to the others; a shift running when the safe state begins aborts
- * (released, ShiftReport AbortReason 3). Leaving Shift mode ends a finished
+ * (released, ShiftReport AbortReason 3), or with the whole shift takes the
+ * fallback of its phase (above; wc_shift.h). Leaving Shift mode ends a finished
  * shift at once (the new mode acts in that very period) and aborts a running
  * one (AbortReason 4, released). Without config.shift, Mode 3 is implausible
  * and ShiftCommand an unknown id. */
 uint32_t wc_loop_step(wc_loop_t *loop, wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
+
+/* The ShiftReport frame of a shift's quality vector, as wc_loop_step sends
+ * it when a shift ends: each figure limited to its DBC range, and Saturated 1
+ * when one was (issue 29 item 7: a peak jerk of 117-131 m/s^3 went out as
+ * 100 with nothing to say so). */
+void wc_loop_shift_report_frame(const wc_shift_report_t *q, wc_can_frame_t *out);
 
 /* When a port's main loop steps the model. */
 typedef enum {
@@ -258,9 +271,11 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
                          wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* All ids the loop can receive: the control frames, ShiftCommand (used only
- * with config.shift), BenchMeasurement (only with bench_input_enabled). */
+ * with config.shift), OffgoingSensors (only with the whole shift),
+ * BenchMeasurement (only with bench_input_enabled). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
-                         WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
+                         WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_OFFGOING_SENSORS_FRAME_ID, \
+                         WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
 #define WC_LOOP_RX_ID_COUNT 5u
 
 /* The receive filter of a port for this configuration: writes the ids the

@@ -287,10 +287,11 @@ static uint16_t status_bits(wc_status_t status)
     return bits;
 }
 
-/* The shift report frame (DBC ShiftReport) of a finished shift. */
-static WC_NOINLINE void encode_report(const wc_shift_report_t *q, wc_can_frame_t *out)
+void wc_loop_shift_report_frame(const wc_shift_report_t *q, wc_can_frame_t *out)
 {
-    const wc_can_shift_report_phys_t report = {
+    WC_ASSERT((q != NULL) && (out != NULL));
+    if ((q == NULL) || (out == NULL)) { return; }
+    wc_can_shift_report_phys_t report = {
         .inertia_phase_time_ms = q->inertia_time_s * 1.0e3f,
         .slip_rmse_rpm = q->slip_rmse_rad_s / WC_RAD_S_PER_RPM,
         .peak_jerk_m_per_s3 = q->peak_jerk_m_s3,
@@ -298,12 +299,17 @@ static WC_NOINLINE void encode_report(const wc_shift_report_t *q, wc_can_frame_t
         .peak_clutch_temp_degC = q->peak_theta_degC,
         .flare = q->flare ? 1.0f : 0.0f,
         .tie_up = q->tie_up ? 1.0f : 0.0f,
+        .saturated = 0.0f,
         .abort_reason = (uint8_t)q->abort_reason,
     };
     out->id = WC_CAN_SHIFT_REPORT_FRAME_ID;
     out->dlc = WC_CAN_SHIFT_REPORT_LENGTH;
     out->flags = 0u;
-    (void)wc_can_encode_shift_report(out->data, &report, sizeof out->data);  /* saturates to the DBC ranges */
+    /* the encoder limits each figure to its DBC range (a NaN: its raw_nan) and says so: the frame then says so too */
+    if (wc_can_encode_shift_report(out->data, &report, sizeof out->data) != WC_CAN_OK) {
+        report.saturated = 1.0f;
+        (void)wc_can_encode_shift_report(out->data, &report, sizeof out->data);
+    }
 }
 
 /* The adaptation report frame (DBC AdaptationReport): what the last shift
@@ -521,7 +527,7 @@ static WC_NOINLINE uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_
     encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
     if (wc_loop_whole_shift(&loop->config)) { n = encode_whole_shift(loop, out, n); }
-    if ((step & STEP_REPORT) != 0u) { encode_report(&loop->report, &out[n++]); }
+    if ((step & STEP_REPORT) != 0u) { wc_loop_shift_report_frame(&loop->report, &out[n++]); }
     if ((step & STEP_ADAPT) != 0u) {
         encode_adaptation(&loop->report.adaptation, loop->adapt.status, &out[n++]);
         if (loop->config.adaptation_changed != NULL) {

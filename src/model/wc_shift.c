@@ -360,6 +360,35 @@ static void fall_back(wc_shift_t *shift, const wc_shift_calibration_t *cal, floa
     }
 }
 
+/* The input back after a finish on the model (DESIGN 14; issue 29 item 7:
+ * the finish looked at the model only and reported a slipping clutch
+ * locked): the shift looks at the slip again. In the inertia phase the
+ * feedback resumes on a reference restarted at the measured slip (bumpless,
+ * as at the phase's start; the report's inertia time counts from the
+ * restart); in the hand-over the ramp restarts from the present request and
+ * the lock-up decides as without a fault (locked, or AbortReason 2). The
+ * report keeps the fallback; the adaptation's window restarts (the fault's
+ * gap is no sample). A LOCKED shift (locked before the fault) holds. */
+static void resume(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, wc_adapt_t *adapt)
+{
+    shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_NONE;
+    shift->fallback_periods = 0u;
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
+        const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
+        enter(shift, WC_SHIFT_INERTIA);
+        shift->start_slip_rad_s = slip_rad_s;
+        shift->band_periods = 0u;
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * feedforward_Nm(&d, 0.0f);
+        wc_adapt_begin(adapt);
+    } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
+        enter(shift, WC_SHIFT_LOCKUP);
+        shift->phase_start_request_Nm = shift->request_Nm;
+        wc_adapt_begin(adapt);
+    } else {
+        /* LOCKED: holds */
+    }
+}
+
 /* Before the clutch step: the transitions on the command and the loop's
  * state, then the clutch input (in place: mode, request, carried torque, lag
  * compensation, temperature source). saturated: the last step's output was. */
@@ -394,10 +423,19 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
             abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
         }
     }
+    if (!safe && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
+        shift->fallback = (uint32_t)WC_SHIFT_FALLBACK_NONE;  /* over with the fault (the report keeps it) */
+    }
+    const bool resumed = coord && !safe && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_FINISH);
     const bool follow = wc_shift_phase_running(shift->phase) || (coord && (shift->phase == (uint32_t)WC_SHIFT_IDLE));
-    if (follow && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+    if (coord && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_FINISH) && !resumed) {
+        /* DESIGN 14: the fallback withdrew the engine request: the driver's torque T_t0, not the last
+         * estimate, which may still hold the reduction (issue 29 item 7) */
+        shift->turbine_torque_Nm = shift->driver_torque_Nm;
+    } else if (follow && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
+    if (resumed) { resume(shift, cal, slip_rad_s, adapt); }
 
     in->mode = WC_MODE_OPEN;
     in->torque_request_Nm = 0.0f;
@@ -436,12 +474,13 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
  * turbine's inertia torque I_t |dref/dt| / a takes the inertia torque out of
  * the clutch (1: the output torque does not hump and does not step at
  * lock-up; more: less friction energy); after the inertia phase what is left
- * ramps out in engine_recovery_time_s. 0 and inactive otherwise, and in a
- * fallback. */
+ * ramps out in engine_recovery_time_s. 0 and inactive otherwise, and from a
+ * fallback to the shift's end. */
 static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s, wc_shift_offgoing_t *og)
 {
     float delta_Nm = 0.0f;
-    bool active = (cal->engine_intervention == 1u) && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
+    /* a fallback withdraws the request for the rest of the shift (no step back in when the input returns) */
+    bool active = (cal->engine_intervention == 1u) && (shift->report.fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
     const float t0_Nm = shift->driver_torque_Nm;
     const float hole_Nm = cal->engine_fill_fraction * (cal->offgoing_ratio - cal->output_ratio) / cal->output_ratio * t0_Nm;
     const float increase_Nm = (hole_Nm < cal->engine_increase_max_Nm) ? hole_Nm : cal->engine_increase_max_Nm;
@@ -567,11 +606,14 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
         }
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
         /* locked once the ramp is done (the lock-up's dwell and the film may end
-         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times; in a fallback the
-         * ramp's end (the slip is not known) */
+         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times */
         const uint32_t ramp = periods_of(cal->lockup_ramp_time_s, dt_s);
-        if ((locked || fallback) && (shift->phase_periods + 1u >= ramp)) { enter(shift, WC_SHIFT_LOCKED); }
-        else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
+        if (fallback) {
+            /* the slip is not known: the hand-over holds, never reported locked (issue 29 item 7); the
+             * input back restarts it (resume), else fall_back releases it after fallback_time_s */
+        } else if (locked && (shift->phase_periods + 1u >= ramp)) {
+            enter(shift, WC_SHIFT_LOCKED);
+        } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
             abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
         }
     }

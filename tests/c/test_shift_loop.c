@@ -140,6 +140,38 @@ static void test_loop_shift_report(void **state)
     assert_int_equal(l.loop.shift.phase, WC_SHIFT_IDLE);
 }
 
+/* A figure beyond its DBC range goes out at the limit with Saturated 1
+ * (issue 29 item 7: a peak jerk of 117-131 m/s^3 was sent as 100, unflagged);
+ * within every range Saturated is 0. */
+static void test_shift_report_saturation_is_flagged(void **state)
+{
+    (void)state;
+    wc_shift_report_t q;
+    memset(&q, 0, sizeof q);
+    q.inertia_time_s = 0.4f;
+    q.slip_rmse_rad_s = 2.0f;
+    q.peak_jerk_m_s3 = 60.0f;
+    q.friction_energy_J = 3000.0f;
+    q.peak_theta_degC = 120.0f;
+    wc_can_frame_t frame;
+    wc_can_shift_report_phys_t r;
+    wc_loop_shift_report_frame(&q, &frame);
+    assert_int_equal(frame.id, WC_CAN_SHIFT_REPORT_FRAME_ID);
+    assert_false(wc_can_is_error(wc_can_decode_shift_report(&r, frame.data, frame.dlc)));
+    assert_float_equal(r.peak_jerk_m_per_s3, 60.0f, 0.05f);  /* tolerance: half the signal's 0.1 m/s^3 step */
+    assert_float_equal(r.saturated, 0.0f, 0.0f);
+    q.peak_jerk_m_s3 = 125.0f;                                /* the probe's figure, above the 100 m/s^3 range */
+    wc_loop_shift_report_frame(&q, &frame);
+    assert_false(wc_can_is_error(wc_can_decode_shift_report(&r, frame.data, frame.dlc)));
+    assert_float_equal(r.peak_jerk_m_per_s3, 100.0f, 0.05f);
+    assert_float_equal(r.saturated, 1.0f, 0.0f);
+    q.peak_jerk_m_s3 = 60.0f;
+    q.friction_energy_J = 45.0e3f;                            /* above the 40 kJ range */
+    wc_loop_shift_report_frame(&q, &frame);
+    assert_false(wc_can_is_error(wc_can_decode_shift_report(&r, frame.data, frame.dlc)));
+    assert_float_equal(r.saturated, 1.0f, 0.0f);
+}
+
 static void test_loop_shift_command_stale(void **state)
 {
     (void)state;
@@ -373,6 +405,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_loop_shift_report),
+        cmocka_unit_test(test_shift_report_saturation_is_flagged),
         cmocka_unit_test(test_loop_shift_command_stale),
         cmocka_unit_test(test_loop_safe_state_after_shift_releases),
         cmocka_unit_test(test_loop_leaving_shift_mode_after_the_shift_has_no_dip),

@@ -54,6 +54,10 @@ typedef struct {
     wc_shift_offgoing_t og;
     float turbine_rad_s;
     uint32_t ended;
+    float truth_factor;           /* the on-coming clutch's true torque / its model's (1: the model is right) */
+    float command_torque_Nm;      /* the command's turbine torque estimate (the engine controller's) */
+    bool torque_follows_engine;   /* the estimate follows the engine request (T_t0 + delta), as an engine's would */
+    bool command_frozen;          /* the estimate stays at its last value (a lost ShiftCommand is held) */
 } rig_t;
 
 static void rig_init(rig_t *r, const wc_shift_calibration_t *cal)
@@ -67,12 +71,17 @@ static void rig_init(rig_t *r, const wc_shift_calibration_t *cal)
     r->og.clutch = &r->off;
     r->og.in = &r->off_in;
     r->og.out = &r->off_out;
+    r->truth_factor = 1.0f;
+    r->command_torque_Nm = TURBINE_TORQUE_Nm;
 }
 
 /* One period; sensor_ok false: the slips are NaN (a lost input) and safe is set. */
 static bool rig_step(rig_t *r, bool request, bool safe, bool sensor_ok, bool coordinate)
 {
-    const wc_shift_command_t command = { request, 2u, TURBINE_TORQUE_Nm, TARGET_TIME_s };
+    if (r->torque_follows_engine && !r->command_frozen) {
+        r->command_torque_Nm = TURBINE_TORQUE_Nm + (r->og.engine_active ? r->og.engine_delta_Nm : 0.0f);
+    }
+    const wc_shift_command_t command = { request, 2u, r->command_torque_Nm, TARGET_TIME_s };
     memset(&r->on_in, 0, sizeof r->on_in);
     memset(&r->off_in, 0, sizeof r->off_in);
     const float slip_on = r->turbine_rad_s - OUTPUT_SPEED_rad_s;
@@ -84,12 +93,21 @@ static bool rig_step(rig_t *r, bool request, bool safe, bool sensor_ok, bool coo
     const bool ended = wc_shift_step(&r->shift, &r->cal, &command, safe, &r->on, NULL, &r->on_in, &r->on_out,
                                      &r->report, coordinate ? &r->og : NULL);
     if (ended) { r->ended++; }
+    if (ended && (r->report.abort_reason == (uint32_t)WC_SHIFT_ABORT_NONE) && sensor_ok) {
+        /* a slipping clutch is never reported locked (issue 29, item 7) */
+        assert_true(fabsf(slip_on) < wc_table1_calibration.lock_slip_rad_s);
+    }
     /* plant: the off-going clutch holds 1st gear while its static capacity carries T_t - T_on */
-    const float t_on = r->on_out.model.torque_Nm;
+    const float t_on = r->truth_factor * r->on_out.model.torque_Nm;
     const float carried = TURBINE_TORQUE_Nm - t_on;
     const bool held = (fabsf(slip_off) < 0.5f) && (r->off_out.static_capacity_Nm >= fabsf(carried));
+    /* the on-coming clutch holds 2nd gear once its model locked, while its true static capacity carries T_t */
+    const bool on_held = ((r->on_out.status & WC_STATUS_LOCKED) != 0u) && (fabsf(slip_on) < 0.5f) &&
+                         (r->truth_factor * r->on_out.static_capacity_Nm >= TURBINE_TORQUE_Nm);
     if (held) {
         r->turbine_rad_s = WHOLE_I1 * OUTPUT_SPEED_rad_s;
+    } else if (on_held) {
+        r->turbine_rad_s = OUTPUT_SPEED_rad_s;
     } else {
         const float t_off = (slip_off > 0.0f ? 1.0f : -1.0f) * 0.9f * r->off_out.static_capacity_Nm;
         r->turbine_rad_s += (TURBINE_TORQUE_Nm - t_on - t_off) / r->cal.turbine_inertia_kg_m2 * DT_s;
@@ -193,11 +211,16 @@ static void test_fault_in_torque_phase_hands_back(void **state)
         assert_int_equal(r.shift.phase, WC_SHIFT_ABORTED);
     }
     assert_int_equal(r.ended, 1u);
+    (void)rig_step(&r, false, false, true, true);  /* withdrawn: IDLE, the fallback over (OffgoingVfsCommand.Fallback 0) */
+    assert_int_equal(r.shift.phase, WC_SHIFT_IDLE);
+    assert_int_equal(r.shift.fallback, WC_SHIFT_FALLBACK_NONE);
+    assert_int_equal(r.report.fallback, WC_SHIFT_FALLBACK_HANDBACK);  /* the report keeps it */
 }
 
 /* A lost input in the inertia phase: finished on the model (the feed-forward
- * on the reference), not released; the engine request withdrawn; the input
- * back does not restart the feedback (no flapping); 2nd gear held. */
+ * on the reference), not released; the engine request withdrawn; once the
+ * loop's debounced recovery gives the input back, the feedback resumes from
+ * the measured slip and the shift locks; 2nd gear held. */
 static void test_fault_in_inertia_phase_finishes_on_the_model(void **state)
 {
     (void)state;
@@ -217,6 +240,75 @@ static void test_fault_in_inertia_phase_finishes_on_the_model(void **state)
     assert_int_equal(r.report.fallback, WC_SHIFT_FALLBACK_FINISH);
     assert_false(r.og.engine_active);
     assert_true(r.on_out.current_mA > wc_table1_calibration.vfs_current_min_mA + 10.0f);  /* holds 2nd gear */
+}
+
+/* A lost input early in the inertia phase, then back, on a clutch weaker
+ * than its model (issue 29, item 7: the probe's case ended LOCKED with 57-66
+ * rad/s of slip): once the input is back the finish looks at the slip; the
+ * feedback takes the model's error and the clutch locks, reported locked
+ * only with the measured slip in the lock band (rig_step's check), and it
+ * stays locked. */
+static void test_input_back_after_a_fallback_looks_at_the_slip(void **state)
+{
+    (void)state;
+    static rig_t r;
+    rig_shift_to(&r, WC_SHIFT_INERTIA, 600u);
+    r.truth_factor = 0.85f;  /* held once locked: 0.85 x holding_torque_factor 1.3 > 1 */
+    for (uint32_t k = 0u; k < 20u; ++k) { (void)rig_step(&r, true, false, true, true); }
+    for (uint32_t k = 0u; k < 60u; ++k) { (void)rig_step(&r, true, true, false, true); }
+    assert_int_equal(r.shift.fallback, WC_SHIFT_FALLBACK_FINISH);
+    for (uint32_t k = 0u; (k < 3000u) && (r.ended == 0u); ++k) { (void)rig_step(&r, true, false, true, true); }
+    assert_int_equal(r.ended, 1u);
+    print_report("input back", &r.report);
+    assert_int_equal(r.report.abort_reason, WC_SHIFT_ABORT_NONE);
+    assert_int_equal(r.report.fallback, WC_SHIFT_FALLBACK_FINISH);  /* the report says the fallback happened */
+    assert_int_equal(r.shift.fallback, WC_SHIFT_FALLBACK_NONE);     /* the state: over */
+    for (uint32_t k = 0u; k < 300u; ++k) {
+        (void)rig_step(&r, true, false, true, true);
+        assert_true(fabsf(r.turbine_rad_s - OUTPUT_SPEED_rad_s) < wc_table1_calibration.lock_slip_rad_s);
+    }
+}
+
+/* A lost input whose fallback ends the inertia phase on the model: while the
+ * slip is unknown the hand-over holds but is not reported locked; the input
+ * never back, it is released after fallback_time_s with AbortReason 3. */
+static void test_fallback_is_not_reported_locked_without_the_slip(void **state)
+{
+    (void)state;
+    static rig_t r;
+    rig_shift_to(&r, WC_SHIFT_INERTIA, 600u);
+    r.cal.fallback_time_s = 4.0f * TARGET_TIME_s;  /* the reference and the hand-over's ramp end in the fault */
+    const uint32_t bound = (uint32_t)(r.cal.fallback_time_s / DT_s + 0.5f);
+    for (uint32_t k = 0u; k < bound + 10u; ++k) {
+        (void)rig_step(&r, true, true, false, true);
+        assert_int_not_equal(r.shift.phase, WC_SHIFT_LOCKED);
+    }
+    assert_int_equal(r.ended, 1u);
+    assert_int_equal(r.report.abort_reason, WC_SHIFT_ABORT_INPUT_LOST);
+    assert_int_equal(r.report.fallback, WC_SHIFT_FALLBACK_RELEASED);
+}
+
+/* The finish on the model withdraws the engine request, so its feed-forward
+ * uses the driver's torque T_t0, not the last estimate, which still holds
+ * the reduction (issue 29, item 7). */
+static void test_fallback_feedforward_without_the_withdrawn_reduction(void **state)
+{
+    (void)state;
+    static rig_t r;
+    const wc_shift_calibration_t cal = whole_cal();
+    rig_init(&r, &cal);
+    r.torque_follows_engine = true;
+    rig_idle(&r, 50u);
+    run_until_phase(&r, WC_SHIFT_INERTIA, 600u);
+    for (uint32_t k = 0u; k < 60u; ++k) { (void)rig_step(&r, true, false, true, true); }
+    assert_true(r.og.engine_active && (r.og.engine_delta_Nm < -1.0f));  /* a reduction under way */
+    r.command_frozen = true;                                            /* the estimate held, reduced */
+    assert_true(r.command_torque_Nm < TURBINE_TORQUE_Nm - 1.0f);
+    for (uint32_t k = 0u; k < 50u; ++k) {
+        (void)rig_step(&r, true, true, false, true);
+        assert_false(r.og.engine_active);
+        assert_float_equal(r.shift.turbine_torque_Nm, TURBINE_TORQUE_Nm, 1e-6f);  /* T_t0, exact: latched */
+    }
 }
 
 /* A lost input at the inertia phase's start, before the off-going clutch's
@@ -296,6 +388,13 @@ static void test_loop_whole_shift_frames(void **state)
     bool has_offgoing = false;
     for (uint32_t i = 0u; i < n_ids; ++i) { has_offgoing = has_offgoing || (ids[i] == WC_CAN_OFFGOING_SENSORS_FRAME_ID); }
     assert_true(has_offgoing);
+    static const uint32_t all_ids[] = WC_LOOP_RX_IDS;  /* the documented list holds every id the loop may use */
+    assert_int_equal(sizeof all_ids / sizeof all_ids[0], WC_LOOP_RX_ID_COUNT);
+    for (uint32_t i = 0u; i < n_ids; ++i) {
+        bool listed = false;
+        for (uint32_t j = 0u; j < WC_LOOP_RX_ID_COUNT; ++j) { listed = listed || (all_ids[j] == ids[i]); }
+        assert_true(listed);
+    }
     uint8_t alive = 0u;
     for (uint32_t k = 0u; k < 80u; ++k) {
         const bool offgoing_present = k < 50u;
@@ -339,6 +438,9 @@ int main(void)
         cmocka_unit_test(test_whole_shift_phases_and_requests),
         cmocka_unit_test(test_fault_in_torque_phase_hands_back),
         cmocka_unit_test(test_fault_in_inertia_phase_finishes_on_the_model),
+        cmocka_unit_test(test_input_back_after_a_fallback_looks_at_the_slip),
+        cmocka_unit_test(test_fallback_is_not_reported_locked_without_the_slip),
+        cmocka_unit_test(test_fallback_feedforward_without_the_withdrawn_reduction),
         cmocka_unit_test(test_fault_at_inertia_start_releases_the_offgoing_clutch),
         cmocka_unit_test(test_long_fault_releases_after_fallback_time),
         cmocka_unit_test(test_coordinator_off_is_the_oncoming_controller),

@@ -241,7 +241,7 @@ static const struct { const char *name; const wc_can_signal_t *sig; } sigs[] = {
     SIG(shift_command, turbine_torque),
     SIG(shift_command, target_inertia_time), SIG(shift_report, inertia_phase_time), SIG(shift_report, slip_rmse),
     SIG(shift_report, peak_jerk), SIG(shift_report, friction_energy), SIG(shift_report, peak_clutch_temp),
-    SIG(shift_report, flare), SIG(shift_report, tie_up),
+    SIG(shift_report, flare), SIG(shift_report, tie_up), SIG(shift_report, saturated),
     SIG(adaptation_report, result), SIG(adaptation_report, node), SIG(adaptation_report, image_missing),
     SIG(adaptation_report, image_invalid), SIG(adaptation_report, friction_scale),
     SIG(adaptation_report, friction_scale_change), SIG(adaptation_report, confidence),

@@ -98,6 +98,8 @@ def test_fallback_of_a_lost_input_per_phase(report):
     assert rows["fault_torque"]["ok"] and rows["fault_torque"]["abort"] == "input lost", rows
     assert rows["fault_inertia"]["ok"] and rows["fault_inertia"]["abort"] == "completed", rows
     assert rows["fault_inertia_long"]["ok"], rows
+    # issue 29 item 7: lost early in the inertia phase and back: locked in 2nd by the plant's truth, not only reported
+    assert rows["fault_inertia_early"]["ok"] and rows["fault_inertia_early"]["abort"] == "completed", rows
     for sc in ("fault_torque", "fault_inertia"):
         assert _c(report[2], sc)["flare_rpm"] <= whole.FLARE_MAX_RPM
 

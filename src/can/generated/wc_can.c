@@ -936,6 +936,7 @@ int wc_can_shift_report_pack(
     dst_p[7] |= pack_left_shift_u8(src_p->flare, 0u, 0x01u);
     dst_p[7] |= pack_left_shift_u8(src_p->tie_up, 1u, 0x02u);
     dst_p[7] |= pack_left_shift_u8(src_p->abort_reason, 2u, 0x1cu);
+    dst_p[7] |= pack_left_shift_u8(src_p->saturated, 5u, 0x20u);
 
     return (8);
 }
@@ -962,6 +963,7 @@ int wc_can_shift_report_unpack(
     dst_p->flare = unpack_right_shift_u8(src_p[7], 0u, 0x01u);
     dst_p->tie_up = unpack_right_shift_u8(src_p[7], 1u, 0x02u);
     dst_p->abort_reason = unpack_right_shift_u8(src_p[7], 2u, 0x1cu);
+    dst_p->saturated = unpack_right_shift_u8(src_p[7], 5u, 0x20u);
 
     return (0);
 }
@@ -1053,6 +1055,16 @@ bool wc_can_shift_report_abort_reason_is_in_range(uint8_t value)
 bool wc_can_shift_report_abort_reason_is_in_phys_range(float value)
 {
     return ((value >= 0.0f) && (value <= 6.0f));
+}
+
+bool wc_can_shift_report_saturated_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_shift_report_saturated_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
 }
 
 int wc_can_adaptation_report_pack(

@@ -98,6 +98,10 @@ const wc_can_signal_t wc_can_sig_shift_report_tie_up = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
 };
+const wc_can_signal_t wc_can_sig_shift_report_saturated = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 1,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
 const wc_can_signal_t wc_can_sig_adaptation_report_result = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 5,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
@@ -490,6 +494,7 @@ wc_can_result_t wc_can_encode_shift_report(uint8_t *dst, const wc_can_shift_repo
     msg.peak_clutch_temp = (uint16_t)to_raw(&wc_can_sig_shift_report_peak_clutch_temp, src->peak_clutch_temp_degC, &result);
     msg.flare = (uint8_t)to_raw(&wc_can_sig_shift_report_flare, src->flare, &result);
     msg.tie_up = (uint8_t)to_raw(&wc_can_sig_shift_report_tie_up, src->tie_up, &result);
+    msg.saturated = (uint8_t)to_raw(&wc_can_sig_shift_report_saturated, src->saturated, &result);
     msg.abort_reason = (uint8_t)(src->abort_reason & 0x07u);
     if (src->abort_reason > 6u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
     if (wc_can_shift_report_pack(dst, &msg, size) < 0) {
@@ -516,6 +521,7 @@ wc_can_result_t wc_can_decode_shift_report(wc_can_shift_report_phys_t *dst, cons
     dst->peak_clutch_temp_degC = to_phys(&wc_can_sig_shift_report_peak_clutch_temp, msg.peak_clutch_temp, &result);
     dst->flare = to_phys(&wc_can_sig_shift_report_flare, msg.flare, &result);
     dst->tie_up = to_phys(&wc_can_sig_shift_report_tie_up, msg.tie_up, &result);
+    dst->saturated = to_phys(&wc_can_sig_shift_report_saturated, msg.saturated, &result);
     dst->abort_reason = msg.abort_reason;
     if (!wc_can_shift_report_abort_reason_is_in_range(msg.abort_reason)) {
         result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);

@@ -47,6 +47,9 @@ FAULTS = {
     "torque": ("torque", 0.0, 0.2),          # hand back to the off-going gear
     "inertia": ("inertia", 0.15, 0.2),       # finish on the model, the input back before the shift's end
     "inertia_long": ("inertia", 0.15, 2.0),  # longer than fallback_time_s: released at last
+    # issue 29 item 7 (the fault probe): lost early in the inertia phase and back while ~60 rad/s of slip
+    # remain; the finish must look at the slip again (locked in 2nd, never reported locked while slipping)
+    "inertia_early": ("inertia", 0.02, 0.05),
 }
 
 

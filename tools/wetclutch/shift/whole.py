@@ -24,7 +24,8 @@ Targets (TARGETS, checked by targets()):
                           jerk than (a) and (b)
   faults                  torque phase: handed back (1st gear, AbortReason 3, fallback 2), no flare; inertia
                           phase: finished on the model (2nd gear, fallback 1), no flare; longer than
-                          fallback_time_s: released (fallback 3)
+                          fallback_time_s: released (fallback 3); lost early in the inertia phase and back:
+                          locked in 2nd by the plant's truth (the finish looks at the slip again)
 """
 from __future__ import annotations
 
@@ -187,7 +188,8 @@ def targets(cases: dict) -> dict:
             ratios[sc] = r
         tg["c_beats_a_and_b"] = {"met": not lost, "lost": lost, "ratios": ratios}
     faults = {}
-    expect = {"fault_torque": (2, 1), "fault_inertia": (1, 2), "fault_inertia_long": (3, None)}
+    expect = {"fault_torque": (2, 1), "fault_inertia": (1, 2), "fault_inertia_long": (3, None),
+              "fault_inertia_early": (1, 2)}
     for sc, (fallback, gear) in expect.items():
         if sc in nom:
             q = nom[sc]
