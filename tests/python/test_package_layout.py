@@ -26,6 +26,7 @@ LAYERS = (
     ("util",),
     ("reference",),
     ("calibration",),
+    ("gearbox",),
     ("generate", "simulate", "hil"),
     ("identify", "shift"),
     ("studies",),

@@ -11,6 +11,7 @@ commands by role (the folder of tools/wetclutch that does the work):
   hil/        replay      bench logs to wc_tcu on vcan0, checked against the reference; the report
               convert     a Vector ASC/BLF log -> candump -L; --to mdf4: a CAN log -> MDF4
   shift/      shift       closed-loop 1->2 upshifts on the plant (simulate/plant)
+  gearbox/    gearbox     a gearbox description -> its shift table (ratios, slips, per-shift models)
   studies/    film-study  the squeeze-film state over a family of bench plants
 calibration/ (loading and checking calibration files) and util/ serve them all.
 """
@@ -293,6 +294,12 @@ def _cmd_vehicle_cal(args) -> int:
     return vehicle_cal.main(argv)
 
 
+def _cmd_gearbox(args) -> int:
+    from .gearbox import table
+    argv = [args.gearbox] + (["--vehicle", args.vehicle] if args.vehicle else []) + (["--out", args.out] if args.out else [])
+    return table.main(argv)
+
+
 def _adaptation_study(args) -> int:
     """wetclutch shift --adaptation-study: the study, its report and plots; exit 1 when a target is missed."""
     from .shift import adaptation_report, adaptation_study
@@ -442,6 +449,13 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("plants_dir", nargs="?", help="directory of vehicle plant files (default tools/plants/vehicles)")
     q.add_argument("--out", help="output directory (default tools/calibrations/vehicles)")
     q.set_defaults(func=_cmd_vehicle_cal)
+    q = sub.add_parser("gearbox", help="check a gearbox description (gear sets, elements, gears) and write its shift"
+                       " table: ratios from the kinematics, element slips, per-shift reduced models (DESIGN 15)")
+    q.add_argument("gearbox", help="gearbox description, any path (e.g. tools/gearboxes/8hp.toml)")
+    q.add_argument("--vehicle", metavar="PATH", help="vehicle plant file, any path: its inertias on the turbine and"
+                   " output side (e.g. tools/plants/vehicles/nominal.toml)")
+    q.add_argument("--out", metavar="PATH", help="shift table to write (default <gearbox stem>_shifts.toml beside it)")
+    q.set_defaults(func=_cmd_gearbox)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")
     q.add_argument("--out", default="out/film_study", help="output directory (default out/film_study)")

@@ -13,8 +13,12 @@ from .rules import _check_relations, _check_value
 def load(path: str | Path) -> Calibration:
     """Read and validate a calibration file. Raises CalibrationError."""
     path = str(path)
-    doc = read_toml(path, CalibrationError, "calibration file")
+    return from_document(read_toml(path, CalibrationError, "calibration file"), path)
 
+
+def from_document(doc: dict, path: str) -> Calibration:
+    """Validate a parsed calibration document (load's checks; the gearbox description's per-element files with
+    their overrides merged in). path names it in every message. Raises CalibrationError."""
     known = {(s, n) for s, n, *_ in PARAMETERS}
     for section, table in doc.items():
         if not isinstance(table, dict):
