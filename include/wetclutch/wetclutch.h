@@ -16,6 +16,7 @@
 #include "wc_lockup.h"
 #include "wc_clutch.h"
 #include "wc_shift.h"
+#include "wc_gearbox.h"
 #include "wc_adapt.h"
 #include "wc_image.h"
 #include "wc_adapt_image.h"

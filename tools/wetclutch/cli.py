@@ -296,8 +296,22 @@ def _cmd_vehicle_cal(args) -> int:
 
 def _cmd_gearbox(args) -> int:
     from .gearbox import table
+    from .generate import gearbox_header
     argv = [args.gearbox] + (["--vehicle", args.vehicle] if args.vehicle else []) + (["--out", args.out] if args.out else [])
-    return table.main(argv)
+    if args.header and not args.vehicle:   # before any work: the header carries the per-shift inertias
+        print("wetclutch gearbox: --header needs --vehicle (the reduced models' inertias)", file=sys.stderr)
+        return 2
+    status = table.main(argv)
+    if status != 0 or not args.header:
+        return status
+    out = Path(args.out) if args.out else Path(args.gearbox).with_name(Path(args.gearbox).stem + "_shifts.toml")
+    command = "wetclutch gearbox " + " ".join(argv) + f" --header {args.header}"
+    try:
+        print(gearbox_header.write_header(out, args.header, command))
+    except (gearbox_header.GearboxHeaderError, OSError) as e:
+        print(f"wetclutch gearbox: {e}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _adaptation_study(args) -> int:
@@ -455,6 +469,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--vehicle", metavar="PATH", help="vehicle plant file, any path: its inertias on the turbine and"
                    " output side (e.g. tools/plants/vehicles/nominal.toml)")
     q.add_argument("--out", metavar="PATH", help="shift table to write (default <gearbox stem>_shifts.toml beside it)")
+    q.add_argument("--header", metavar="PATH", help="also the firmware's C header of the table (wc_gearbox_t,"
+                   " include/wetclutch/wc_gearbox.h), e.g. lut/wc_8hp_gearbox.h; needs --vehicle")
     q.set_defaults(func=_cmd_gearbox)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")
