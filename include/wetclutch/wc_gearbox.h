@@ -15,6 +15,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "wc_shift.h"
+
 /* Bounds (no heap: the tables are fixed arrays). */
 #define WC_GEARBOX_ELEMENTS_MAX 6u   /* shift elements (8HP: 5) */
 #define WC_GEARBOX_GEARS_MAX 11u     /* reverse + up to 10 forward */
@@ -96,6 +98,34 @@ typedef enum {
  * set to its table row, else the reason and *shift NULL. gearbox checked. */
 wc_gearbox_shift_result_t wc_gearbox_find_shift(const wc_gearbox_t *gearbox, uint32_t current_gear,
                                                 uint32_t target_gear, const wc_gearbox_shift_t **shift);
+
+/* The four shift types of DESIGN 15, from the direction (an upshift goes
+ * to a lower ratio) and the sign of the turbine torque (the engine pulling:
+ * power-on; dragging: power-off). */
+typedef enum {
+    WC_SHIFT_TYPE_POWER_ON_UP = 0,     /* torque phase, then inertia phase (DESIGN 14) */
+    WC_SHIFT_TYPE_POWER_OFF_UP = 1,    /* tip-out: inertia phase (the off-going element slips), hand-over at synchronism */
+    WC_SHIFT_TYPE_POWER_ON_DOWN = 2,   /* kickdown: inertia phase (a controlled flare), torque phase at synchronism */
+    WC_SHIFT_TYPE_POWER_OFF_DOWN = 3   /* coast: torque phase, then the on-coming element pulls the turbine up */
+} wc_shift_type_t;
+
+/* The type of a shift of the table at this turbine torque; a torque of 0
+ * counts as power-off (the engine at most drags); NaN: power-on (the type
+ * whose torque phase comes first on an upshift and whose inertia phase is
+ * held by the off-going element on a downshift: the element that has the
+ * gear keeps it until the torque is known). */
+wc_shift_type_t wc_gearbox_shift_type(const wc_gearbox_t *gearbox, const wc_gearbox_shift_t *shift,
+                                      float turbine_torque_Nm);
+
+/* The shift controller's calibration for one shift of the table (DESIGN
+ * 10, 14, 15): base with its driveline model replaced by the row's reduced
+ * one (turbine_ratio 1, output_ratio b, offgoing_ratio b1, the two inertias,
+ * the jerk factor), the rest (phases, gains, fill, engine, adaptation) kept.
+ * The controller's torque is the on-coming element's torque times
+ * oncoming_slip_scale; the caller converts. Returns wc_shift_calibration_check
+ * of the result. */
+wc_shift_cal_error_t wc_gearbox_shift_calibration(const wc_shift_calibration_t *base, const wc_gearbox_shift_t *shift,
+                                                  wc_shift_calibration_t *out);
 
 /* An element's own slip in a shift, a w_t - b w_o (rad/s); NaN in, NaN out
  * (the caller's input rules decide what an invalid speed means). */

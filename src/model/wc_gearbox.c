@@ -178,3 +178,30 @@ float wc_gearbox_holding_request_Nm(const wc_gearbox_t *gearbox, uint32_t gear, 
     const float request_Nm = (need_Nm > floor_abs_Nm) ? need_Nm : floor_abs_Nm;
     return (request_Nm < WC_TORQUE_MAX_Nm) ? request_Nm : WC_TORQUE_MAX_Nm;
 }
+
+wc_shift_type_t wc_gearbox_shift_type(const wc_gearbox_t *gearbox, const wc_gearbox_shift_t *shift,
+                                      float turbine_torque_Nm)
+{
+    WC_ASSERT((gearbox != NULL) && (shift != NULL));
+    /* DESIGN 15: an upshift goes to the lower ratio (the check keeps forward ratios decreasing) */
+    const bool up = (gearbox == NULL) || (shift == NULL) || (shift->target_gear > shift->source_gear);
+    const bool power_off = turbine_torque_Nm <= 0.0f;  /* false for NaN: power-on */
+    if (up) { return power_off ? WC_SHIFT_TYPE_POWER_OFF_UP : WC_SHIFT_TYPE_POWER_ON_UP; }
+    return power_off ? WC_SHIFT_TYPE_POWER_OFF_DOWN : WC_SHIFT_TYPE_POWER_ON_DOWN;
+}
+
+wc_shift_cal_error_t wc_gearbox_shift_calibration(const wc_shift_calibration_t *base, const wc_gearbox_shift_t *shift,
+                                                  wc_shift_calibration_t *out)
+{
+    WC_ASSERT((base != NULL) && (shift != NULL) && (out != NULL));
+    if ((base == NULL) || (shift == NULL) || (out == NULL)) { return WC_SHIFT_CAL_NULL; }
+    *out = *base;
+    /* DESIGN 15: the paper's reduction (§2, Fig. 1) of this shift, normalised by the on-coming element's a */
+    out->turbine_ratio = 1.0f;
+    out->output_ratio = shift->output_ratio;
+    out->offgoing_ratio = shift->offgoing_ratio;
+    out->turbine_inertia_kg_m2 = shift->turbine_inertia_kg_m2;
+    out->output_inertia_kg_m2 = shift->output_inertia_kg_m2;
+    out->jerk_per_torque_rate = shift->jerk_per_torque_rate;
+    return wc_shift_calibration_check(out);
+}

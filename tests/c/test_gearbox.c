@@ -10,6 +10,7 @@
 #include <wetclutch/wc_gearbox.h>
 
 #include "wc_8hp_gearbox.h"
+#include "wc_shift_1_2_shift.h"
 
 #define ELEMENT_A 0u
 #define ELEMENT_B 1u
@@ -111,6 +112,54 @@ static void test_holding_request(void **state)
     assert_float_equal(wc_gearbox_holding_request_Nm(g, 1u, ELEMENT_B, 1e30f, 1.2f, 20.0f), WC_TORQUE_MAX_Nm, 0.0f);
 }
 
+/* DESIGN 15's four types from the direction and the turbine torque's sign. */
+static void test_shift_types(void **state)
+{
+    (void)state;
+    const wc_gearbox_t *g = &wc_gearbox_8hp;
+    const wc_gearbox_shift_t *up = NULL;
+    const wc_gearbox_shift_t *down = NULL;
+    assert_int_equal(wc_gearbox_find_shift(g, 3u, 4u, &up), WC_GEARBOX_SHIFT_OK);
+    assert_int_equal(wc_gearbox_find_shift(g, 6u, 4u, &down), WC_GEARBOX_SHIFT_OK);  /* a skip downshift */
+    assert_int_equal(wc_gearbox_shift_type(g, up, 150.0f), WC_SHIFT_TYPE_POWER_ON_UP);
+    assert_int_equal(wc_gearbox_shift_type(g, up, -20.0f), WC_SHIFT_TYPE_POWER_OFF_UP);
+    assert_int_equal(wc_gearbox_shift_type(g, up, 0.0f), WC_SHIFT_TYPE_POWER_OFF_UP);
+    assert_int_equal(wc_gearbox_shift_type(g, down, 300.0f), WC_SHIFT_TYPE_POWER_ON_DOWN);
+    assert_int_equal(wc_gearbox_shift_type(g, down, -20.0f), WC_SHIFT_TYPE_POWER_OFF_DOWN);
+    assert_int_equal(wc_gearbox_shift_type(g, down, NAN), WC_SHIFT_TYPE_POWER_ON_DOWN);
+    uint32_t per_type[4] = { 0u, 0u, 0u, 0u };
+    for (uint32_t i = 0u; i < g->shift_count; ++i) { per_type[wc_gearbox_shift_type(g, &g->shift[i], 100.0f)]++; }
+    assert_int_equal(per_type[WC_SHIFT_TYPE_POWER_ON_UP], 18u);    /* the table's 18 upshifts (7 single steps, 11 skips) */
+    assert_int_equal(per_type[WC_SHIFT_TYPE_POWER_ON_DOWN], 18u);
+}
+
+/* Today's 1->2 calibration with the 8HP table's 1-2 reduced model: a valid
+ * calibration whose driveline differs from today's by what the gear sets add
+ * (the difference stated in the assertions: b 3.1304 vs 3.1, b1 4.6957 vs
+ * 4.7, I_t 0.304 vs 0.25 kg m^2: the intermediate shafts), the rest kept;
+ * and every power-on upshift of the table gives a valid calibration. */
+static void test_per_shift_calibration(void **state)
+{
+    (void)state;
+    const wc_gearbox_t *g = &wc_gearbox_8hp;
+    const wc_shift_calibration_t *base = &wc_shift_1_2_whole_full;
+    const wc_gearbox_shift_t *s = NULL;
+    wc_shift_calibration_t cal;
+    assert_int_equal(wc_gearbox_find_shift(g, 1u, 2u, &s), WC_GEARBOX_SHIFT_OK);
+    assert_int_equal(wc_gearbox_shift_calibration(base, s, &cal), WC_SHIFT_CAL_OK);
+    assert_float_equal(cal.output_ratio, 3.13043f, 0.0f);
+    assert_float_equal(base->output_ratio, 3.1f, 1e-6f);
+    assert_float_equal(cal.offgoing_ratio, 4.69565f, 0.0f);
+    assert_float_equal(cal.turbine_inertia_kg_m2, 0.303723f, 0.0f);
+    assert_float_equal(cal.kp_Nm_per_rad_s, base->kp_Nm_per_rad_s, 0.0f);
+    assert_int_equal(cal.coordinator, base->coordinator);
+    for (uint32_t i = 0u; i < g->shift_count; ++i) {
+        assert_int_equal(wc_gearbox_shift_calibration(base, &g->shift[i], &cal),
+                         (g->shift[i].target_gear > g->shift[i].source_gear) ? WC_SHIFT_CAL_OK : WC_SHIFT_CAL_OFFGOING_RATIO);
+    }
+    assert_int_equal(wc_gearbox_shift_calibration(base, NULL, &cal), WC_SHIFT_CAL_NULL);
+}
+
 /* One corruption of each kind, each caught with its code. */
 static void test_check_refuses_corruptions(void **state)
 {
@@ -151,6 +200,8 @@ int main(void)
         cmocka_unit_test(test_shift_classification_matches_the_tool),
         cmocka_unit_test(test_slip_maps_follow_the_kinematics),
         cmocka_unit_test(test_holding_request),
+        cmocka_unit_test(test_shift_types),
+        cmocka_unit_test(test_per_shift_calibration),
         cmocka_unit_test(test_check_refuses_corruptions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
