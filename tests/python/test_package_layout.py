@@ -30,6 +30,7 @@ LAYERS = (
     ("generate", "simulate", "hil"),
     ("identify", "shift"),
     ("studies",),
+    ("cycle",),
     ("cli",),
 )
 TYPE_ONLY_ALLOWED = {("reference", "wetclutch.calibration.parameters")}
