@@ -2,7 +2,7 @@
 """A service technician's tester against ``wc_tcu --uds`` (DESIGN 17), run where the SocketCAN interface is
 (natively, or inside the QEMU guest of hil/vcan_run.sh) by hil/uds_guest.sh:
 
-    python hil/uds_tester.py --secret SECRET_FILE --out RESULT.json [--iface vcan0]
+    python hil/uds_tester.py --secret SECRET_FILE --out RESULT.json [--iface vcan0] [--phase session|restart]
 
 The tester is udsoncan over python-can-isotp (the pure-Python ISO-TP stack on a python-can socketcan bus),
 nobody's code here. It records what it saw in RESULT.json (as far as it got, if a step fails);
@@ -10,10 +10,14 @@ tests/python/test_uds_session.py checks it with the bus capture. The session: id
 DIDs, the learned values and temperatures; ClearDiagnosticInformation and the adaptation reset refused
 while locked (0x33); the extended session; SecurityAccess with a wrong key (0x35) then the right one
 (HMAC-SHA256 of the seed with the device secret, Python's hmac); the adaptation reset routine; the request
-timeout injected by the played log read as a DTC with its snapshot, cleared; three wrong keys (0x35,
-0x35, 0x36), the delay (0x37), then unlocked again. Every wait is on the TCU's answers, bounded by a count
-of requests, never on the clock; the timeouts are generous (an emulated guest is slow): a slower guest
-makes the session slower, never different (DESIGN 5)."""
+timeout injected by the played log read as a DTC with its snapshot; an ECUReset (softReset): the default
+session, locked, the start's security delay, a new operation cycle; unlocked again, the DTCs cleared;
+three wrong keys (0x35, 0x35, 0x36), the delay (0x37), then unlocked again; the hot clutch of the played
+log read as a confirmed DTC with its snapshot. The restart phase (wc_tcu started again on the fault
+memory's image, fault-free inputs): that DTC still confirmed with the same snapshot, then ECUResets, each
+an operation cycle without the fault, until it ages out. Every wait is on the TCU's answers, bounded by a
+count of requests, never on the clock; the timeouts are generous (an emulated guest is slow): a slower
+guest makes the session slower, never different (DESIGN 5)."""
 from __future__ import annotations
 
 import argparse
@@ -40,6 +44,8 @@ from udsoncan.connections import PythonIsoTpConnection  # noqa: E402
 REQUEST_ID, FUNCTIONAL_ID, RESPONSE_ID = 0x7E1, 0x7DF, 0x7E9   # hil/wetclutch.dbc
 KEY_BYTES = 16                                               # src/port/wc_tcu_diag.c
 REQUEST_TIMEOUT_DTC = 0xD10187                               # U1101-87 TorqueRequest missing
+OVER_TEMPERATURE_DTC = 0x170098                              # P1700-98 clutch over temperature
+AGING_CYCLES = 40                                            # DTC_AGING_CYCLES, src/port/wc_tcu_diag.c
 ADAPTATION_RESET = 0x0201
 SNAPSHOT_DID = 0xDD00
 NODES = 5                                                    # WC_ADAPT_NODES
@@ -103,6 +109,28 @@ def _dtcs(client, mask: int) -> dict:
     return {d.id: d.status.get_byte_as_int() for d in response.service_data.dtcs}
 
 
+def _snapshot(client, dtc: int) -> list:
+    """The DTC's snapshot records (empty: none stored)."""
+    records = client.get_dtc_snapshot_by_dtc_number(dtc, record_number=1).service_data.dtcs[0].snapshots
+    return [{"record": s.record_number, "did": s.did, "values": list(s.data)} for s in records]
+
+
+def _await_status(client, dtc: int, bits: int):
+    """Polls reportDTCByStatusMask until the DTC's status has every bit of bits; its status then (or the
+    last one seen)."""
+    status = None
+    for _ in range(POLLS):
+        status = _dtcs(client, 0xFF).get(dtc)
+        if status is not None and status & bits == bits:
+            break
+    return status
+
+
+def _soft_reset(client) -> int:
+    """ECUReset softReset: 0, or the NRC."""
+    return _nrc(lambda: client.ecu_reset(udsoncan.services.ECUReset.ResetType.softReset))
+
+
 def session(client, secret: bytes, result: dict) -> None:
     lap = time.monotonic()
 
@@ -159,9 +187,20 @@ def session(client, secret: bytes, result: dict) -> None:
     result["dtc_status"] = status
     result["dtcs"] = {f"{k:06X}": v for k, v in _dtcs(client, 0xFF).items()}
     result["confirmed_count"] = client.get_number_of_dtc_by_status_mask(0x08).service_data.dtc_count
-    snap = client.get_dtc_snapshot_by_dtc_number(REQUEST_TIMEOUT_DTC, record_number=1).service_data.dtcs[0]
-    result["snapshot"] = [{"record": s.record_number, "did": s.did, "values": list(s.data)} for s in snap.snapshots]
+    result["snapshot"] = _snapshot(client, REQUEST_TIMEOUT_DTC)
     mark("dtc")
+    # a soft reset, right after the request timeout passed (the next one is a log's loop away): answered,
+    # then the loop restarts (the capture shows it) and the server as after a start: the default session,
+    # locked, the start's security delay; a new operation cycle (testFailedThisOperationCycle 0)
+    reset = {"answer": _soft_reset(client)}
+    reset["seed_in_default_session"] = _nrc(lambda: client.request_seed(1))
+    reset["clear"] = _nrc(lambda: client.clear_dtc(0xFFFFFF))
+    reset["dtc_status"] = _dtcs(client, 0xFF).get(REQUEST_TIMEOUT_DTC)
+    client.change_session(udsoncan.services.DiagnosticSessionControl.Session.extendedDiagnosticSession)
+    reset["delay_answers"] = _delay_answers(client)
+    client.unlock_security_access(1)
+    result["soft_reset"] = reset
+    mark("soft_reset")
     result["clear"] = _nrc(lambda: client.clear_dtc(0xFFFFFF))
     # reportDTCByStatusMask lists a DTC whose status has a bit of the mask: a status of 0 (tested and
     # passed since the clear) is not listed
@@ -180,6 +219,28 @@ def session(client, secret: bytes, result: dict) -> None:
     client.unlock_security_access(1)   # udsoncan's own seed & key exchange with security_algo
     result["unlocked_after_delay"] = True
     mark("delay")
+    # the played log's hot clutch (since the clear, in this operation cycle): confirmed, with its snapshot
+    # (the restart phase finds the same)
+    status = _await_status(client, OVER_TEMPERATURE_DTC, 0x08 | 0x02)
+    result["over_temperature"] = {"status": status, "snapshot": _snapshot(client, OVER_TEMPERATURE_DTC)}
+    mark("over_temperature")
+
+
+def restart(client, result: dict) -> None:
+    """After wc_tcu's restart on the fault memory's image: the hot clutch's DTC as it was stored, then
+    soft resets (each an operation cycle without the fault: fault-free inputs) until it ages out."""
+    result["dtcs"] = {f"{k:06X}": v for k, v in _dtcs(client, 0xFF).items()}
+    result["snapshot"] = _snapshot(client, OVER_TEMPERATURE_DTC)
+    cycles, status = 0, result["dtcs"].get(f"{OVER_TEMPERATURE_DTC:06X}", 0)
+    answers = []
+    while status & 0x08 and cycles < AGING_CYCLES + 5:
+        answers.append(_soft_reset(client))
+        cycles += 1
+        status = _dtcs(client, 0xFF).get(OVER_TEMPERATURE_DTC, 0)
+    result["reset_answers"] = sorted(set(answers))
+    result["cycles_until_aged"] = cycles
+    result["status_aged"] = status
+    result["snapshot_aged"] = _snapshot(client, OVER_TEMPERATURE_DTC)
 
 
 def main() -> int:
@@ -187,6 +248,7 @@ def main() -> int:
     ap.add_argument("--secret", required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--iface", default="vcan0")
+    ap.add_argument("--phase", choices=("session", "restart"), default="session")
     args = ap.parse_args()
     secret = open(args.secret, "rb").read()
     result: dict = {"imports_s": round(time.monotonic() - _STARTED, 2)}
@@ -200,7 +262,10 @@ def main() -> int:
     rc = 0
     try:
         with Client(PythonIsoTpConnection(stack), config=_config(secret)) as client:
-            session(client, secret, result)
+            if args.phase == "session":
+                session(client, secret, result)
+            else:
+                restart(client, result)
         result["ok"] = True
     except Exception as e:  # noqa: BLE001 (recorded for the test's message)
         result["failed"] = f"{type(e).__name__}: {e}"

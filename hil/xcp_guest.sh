@@ -11,53 +11,37 @@
 # and records ClutchSensors, VfsCommand and the XCP frames; pyxcp runs the session
 # (hil/xcp_master.py), waiting on the TCU's steps, never on the clock. Output in DIR: result.json (the
 # session), capture.log, stats.json and tcu.txt (wc_tcu), play.txt (wc_canplay), session.txt (the master's
-# messages). Exits with the session's code.
+# messages). Exits with the session's code. The start-up and shut-down: hil/guest_lib.sh.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=hil/guest_lib.sh
 source "$repo/hil/guest_lib.sh"
-die() { echo "xcp_guest: $*" >&2; exit 2; }
-[ $# -ge 1 ] || die "usage: $0 DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]"
-dir=$(cd "$1" && pwd) || die "no directory $1"; shift
-iface=vcan0 tcu="$repo/build/host-release/src/port/wc_tcu" daq_samples=5000
+guest_init xcp_guest
+[ $# -ge 1 ] || guest_die "usage: $0 DIR [--iface vcan0] [--tcu PATH] [--daq-samples N]"
+work=$1; shift
+daq_samples=5000
 while [ $# -gt 0 ]; do
+  [ $# -ge 2 ] || guest_die "option '$1' needs a value"
   case $1 in
-    --iface) iface=$2; shift 2 ;;
-    --tcu) tcu=$2; shift 2 ;;
-    --daq-samples) daq_samples=$2; shift 2 ;;
-    *) die "unknown option '$1'" ;;
+    --daq-samples) daq_samples=$2 ;;
+    *) guest_option "$1" "$2" || guest_die "unknown option '$1'" ;;
   esac
+  shift 2
 done
-player=$(dirname "$tcu")/wc_canplay
-for f in input.log cal.img plan.json secret.bin; do [ -r "$dir/$f" ] || die "cannot read $dir/$f"; done
-for program in "$tcu" "$player"; do
-  [ -x "$program" ] || die "$program not built (cmake --preset host-release && cmake --build --preset host-release)"
-done
+guest_check "$work" input.log cal.img plan.json secret.bin
 # Socket buffers: the master's Python may fall behind 8 DAQ frames a step on an emulated CPU; the frames
 # wait in its socket instead of being dropped (where the system permits it).
 sysctl -q -w net.core.rmem_max=67108864 net.core.rmem_default=67108864 2>/dev/null || true
-cd "$dir"
 # the master's flow control of the inputs during DAQ, on the guest's own tmpfs (a FIFO over 9p is not one)
 fifo_dir=$(mktemp -d /dev/shm/xcp.XXXXXX 2>/dev/null || mktemp -d)
 trap 'rm -rf "$fifo_dir"' EXIT
 mkfifo "$fifo_dir/limit"
-"$tcu" --iface "$iface" --clock frame --xcp --secret-file secret.bin --calibration-image cal.img --theta-start 60 \
-  --stats-json stats.json 2> tcu.txt &
-tcu_pid=$!
-await_line tcu.txt "clock frame" "$tcu_pid" || { cat tcu.txt >&2; die "wc_tcu did not start"; }
+guest_start_tcu --xcp --secret-file secret.bin --calibration-image cal.img --theta-start 60 --stats-json stats.json
 # the player and the master on one CPU (--cpu 0): a raw command reaches the TCU in order with the inputs
-"$player" input.log --iface "$iface" --cpu 0 --loops 0 --pace log --limit-fifo "$fifo_dir/limit" --stop-pid "$tcu_pid" \
-  --record capture.log \
-  --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1 2> play.txt &
-play=$!
-rc=0
+guest_start_player input.log --cpu 0 --limit-fifo "$fifo_dir/limit" --record capture.log \
+  --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1
 "$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" --secret-file secret.bin \
   --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" --cpu 0 > session.txt 2>&1 || rc=$?
-kill -TERM "$play" 2>/dev/null   # the player stops, then stops wc_tcu and records its last frames
-play_rc=0; wait "$play" || play_rc=$?
-tcu_rc=0; wait "$tcu_pid" || tcu_rc=$?
-cat play.txt >&2
-if [ "$play_rc" -ne 0 ]; then echo "xcp_guest: wc_canplay failed (exit $play_rc), see $dir/play.txt" >&2; [ "$rc" -ne 0 ] || rc=$play_rc; fi
-if [ "$tcu_rc" -ne 0 ]; then echo "xcp_guest: wc_tcu failed (exit $tcu_rc), see $dir/tcu.txt" >&2; [ "$rc" -ne 0 ] || rc=$tcu_rc; fi
+guest_stop
 [ "$rc" -eq 0 ] || echo "xcp_guest: the XCP session failed (exit $rc), see $dir/session.txt" >&2
 exit "$rc"

@@ -14,12 +14,16 @@
 #    calibration reads 1000, the naive inverse agrees with wc_inverse, every
 #    loop frame was accepted) and their outputs are byte-identical.
 # 3. Prints one table (function | -Os median / worst | -O2 median / worst),
-#    the naive/library ratio of the inverse, the whole shift's state sizes (the
-#    probe's RAM lines, which must agree between the levels) and the flash of
-#    each library (and of the XCP slave's object in the CAN layer) per
-#    level, and writes it to build/arm-bench/report.md.
+#    the naive/library ratio of the inverse, the state sizes (the probe's RAM
+#    lines, which must agree between the levels: the whole shift's, the
+#    diagnostic server's) and the flash of each library (and of the XCP
+#    slave's, ISO-TP's, the UDS server's and the fault memory's objects in the
+#    CAN layer) per level, and writes it to build/arm-bench/report.md.
 # 4. FAILS when a worst case exceeds its ceiling in bench/arm_ceilings.txt, or
-#    when a measured function has no ceiling there (for either level).
+#    when a measured function has no ceiling there (for either level); the
+#    same for the flash (text + data) of the diagnostic objects (lines
+#    flash:wc_isotp.c, flash:wc_uds.c, flash:wc_dtc.c) and their RAM (lines
+#    ram:wc_isotp_t, ram:wc_uds_t, ram:wc_dtc_t).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
@@ -102,12 +106,12 @@ for level in "${levels[@]}"; do
   ratio_worst[$level]=$(awk '$1 == "NAIVE" && $2 == "ratio_solve_median" { print $5 }' "$out")
   force_diff[$level]=$(awk '$1 == "NAIVE" && $2 == "force_diff_worst_N" { print $3 }' "$out")
 
-  for lib in model can xcp cal; do
+  for lib in model can xcp isotp uds dtc cal; do
     member=
     case $lib in
       model) archive=$build/wetclutch/src/model/libwetclutch.a ;;
       can) archive=$build/wetclutch/src/can/libwetclutch_can.a ;;
-      xcp) archive=$build/wetclutch/src/can/libwetclutch_can.a; member=wc_xcp.c.obj ;;
+      xcp|isotp|uds|dtc) archive=$build/wetclutch/src/can/libwetclutch_can.a; member=wc_$lib.c.obj ;;
       cal) archive=$build/libwc_arm_calibration.a ;;
     esac
     t=
@@ -149,16 +153,31 @@ while read -r fn lvl max extra; do
 done <"$ceilings"
 
 violations=()
-for name in "${names[@]}"; do
+# gate NAME UNIT: NAME's worst at each level against its ceiling; missing or above it: a violation
+gate() {
+  local name=$1 unit=$2 level
   for level in "${levels[@]}"; do
     if [ -z "${worst[$level,$name]:-}" ]; then
       violations+=("$name was not measured at -$level")
     elif [ -z "${ceiling[$name,$level]:-}" ]; then
-      violations+=("no ceiling for '$name' at level $level in $ceilings (add a line: $name $level <max_instructions>)")
+      violations+=("no ceiling for '$name' at level $level in $ceilings (add a line: $name $level <max_$unit>)")
     elif [ "${worst[$level,$name]}" -gt "${ceiling[$name,$level]}" ]; then
-      violations+=("$name at -$level: worst ${worst[$level,$name]} instructions > ceiling ${ceiling[$name,$level]}")
+      violations+=("$name at -$level: worst ${worst[$level,$name]} $unit > ceiling ${ceiling[$name,$level]}")
     fi
   done
+}
+for name in "${names[@]}"; do gate "$name" instructions; done
+# The diagnostic server's flash (text + data of its objects) and RAM (sizeof), gated like the rows.
+for level in "${levels[@]}"; do
+  for lib in isotp uds dtc; do
+    worst[$level,flash:wc_$lib.c]=$(( flash_text[$level,$lib] + flash_data[$level,$lib] ))
+  done
+  for type in wc_isotp_t wc_uds_t wc_dtc_t; do
+    worst[$level,ram:$type]=${ram[$level,$type]:-}
+  done
+done
+for gated in flash:wc_isotp.c flash:wc_uds.c flash:wc_dtc.c ram:wc_isotp_t ram:wc_uds_t ram:wc_dtc_t; do
+  gate "$gated" bytes
 done
 for key in "${!ceiling[@]}"; do
   if [ -z "${worst[${key#*,},${key%,*}]:-}" ]; then
@@ -197,7 +216,7 @@ qemu_version=$(qemu-system-arm --version | awk 'NR == 1 { print $4 }')
     echo "| -$level | ${ratio_median[$level]} | ${ratio_worst[$level]} | ${force_diff[$level]} N |"
   done
   echo
-  echo "RAM of the whole shift (DESIGN 14; sizeof on the target, the probe's RAM lines):"
+  echo "RAM (sizeof on the target, the probe's RAM lines): the whole shift (DESIGN 14), the diagnostic server (DESIGN 17):"
   echo
   echo "| state | bytes |"
   echo "|---|---:|"
@@ -206,23 +225,33 @@ qemu_version=$(qemu-system-arm --version | awk 'NR == 1 { print $4 }')
       wc_loop_t) label='`wc_loop_t` (one per clutch pair: holds the off-going clutch too)' ;;
       wc_loop_t.offgoing_parts) label='of which the off-going clutch, its input, output, E2E input and sensors' ;;
       whole_shift_step_state) label='`wc_shift_step` caller: `wc_shift_t` + two clutches with input and output' ;;
+      wc_isotp_t) label='`wc_isotp_t` (ISO-TP: receive ring, request and response buffers)' ;;
+      wc_uds_t) label='`wc_uds_t` (the UDS server)' ;;
+      wc_dtc_t) label='`wc_dtc_t` (the fault memory)' ;;
       *) label="\`$name\`" ;;
     esac
-    echo "| $label | ${ram[${levels[0]},$name]} |"
+    gate=
+    [ -n "${ceiling[ram:$name,${levels[0]}]:-}" ] && gate=" (ceiling ${ceiling[ram:$name,${levels[0]}]})"
+    echo "| $label | ${ram[${levels[0]},$name]}$gate |"
   done
   echo
   echo "Flash (arm-none-eabi-size, text / data / bss in bytes):"
   echo
   echo "| library | -Os | -O2 |"
   echo "|---|---:|---:|"
-  for lib in model can xcp cal; do
+  for lib in model can xcp isotp uds dtc cal; do
     case $lib in
       model) label='model, `libwetclutch.a`' ;;
       can) label='CAN layer, `libwetclutch_can.a`' ;;
       xcp) label='of which the XCP slave, `wc_xcp.c`' ;;
+      isotp) label='of which ISO-TP, `wc_isotp.c`' ;;
+      uds) label='of which the UDS server, `wc_uds.c`' ;;
+      dtc) label='of which the fault memory, `wc_dtc.c`' ;;
       cal) label='table1 calibration + h̄ LUT (`wc_arm_calibration.c`)' ;;
     esac
-    echo "| $label | ${flash_text[Os,$lib]} / ${flash_data[Os,$lib]} / ${flash_bss[Os,$lib]} | ${flash_text[O2,$lib]} / ${flash_data[O2,$lib]} / ${flash_bss[O2,$lib]} |"
+    gate=
+    [ -n "${ceiling[flash:wc_$lib.c,Os]:-}" ] && gate=" (text + data ceiling ${ceiling[flash:wc_$lib.c,Os]} / ${ceiling[flash:wc_$lib.c,O2]})"
+    echo "| $label$gate | ${flash_text[Os,$lib]} / ${flash_data[Os,$lib]} / ${flash_bss[Os,$lib]} | ${flash_text[O2,$lib]} / ${flash_data[O2,$lib]} / ${flash_bss[O2,$lib]} |"
   done
 } >"$report"
 

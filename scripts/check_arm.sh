@@ -20,8 +20,8 @@
 # 4. Prints text/data/bss, worst stack per public function (own frame from
 #    -fstack-usage, summed along the call graph from -fcallgraph-info=su; libm
 #    callees such as expf from their prologues in the linked image), state bytes
-#    per clutch and the inverse's iteration bound, as a block to paste into the
-#    README. Goals (issue 19): flash <= 10 KiB, stack <= 320 B, state <= 64 B. Set
+#    per clutch and the inverse's iteration bound, as a block to paste into
+#    docs/results.md. Goals (issue 19): flash <= 10 KiB, stack <= 320 B, state <= 64 B. Set
 #    WC_ARM_STRICT=1 to fail when a goal is missed as well.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)

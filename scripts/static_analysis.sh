@@ -8,7 +8,7 @@
 #    line, with its reason: // cppcheck-suppress <id> -- <why>
 # 2. The cppcheck MISRA C:2012 addon over the portable core (src/model,
 #    src/can and the public headers), printed as counts per rule, hand-written
-#    code and generated code apart. NOT gating: README.md lists the rules the
+#    code and generated code apart. NOT gating: docs/integrating.md lists the rules the
 #    project deviates from and why.
 #
 #   bash scripts/static_analysis.sh [BUILD_DIR]     default build/host-debug

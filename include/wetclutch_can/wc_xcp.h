@@ -36,6 +36,16 @@
  * hook's (or of another length): ERR_ACCESS_LOCKED and the session
  * disconnected, as the standard says. DISCONNECT (and a wrong key) restores
  * the protection. The library hand-rolls no cryptography.
+ * Failed attempts (DESIGN 17): the wrong keys in a row are counted across
+ * sessions (a DISCONNECT or a new CONNECT does not reset the count; a right
+ * key does); at config.unlock_attempts of them a lock-out of
+ * config.unlock_delay_steps control steps (wc_xcp_step with control_step)
+ * begins, during which GET_SEED of a protected resource answers
+ * ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE (the GET_SEED row of the XCP 1.x
+ * error matrix: "access to the requested resource is temporary not
+ * possible"; ERR_ACCESS_LOCKED is not in that row), so no key can be tried;
+ * the protected commands keep answering ERR_ACCESS_LOCKED. The lock-out's
+ * end starts the count from 0. A start (wc_xcp_init) has no lock-out.
  *
  * Build option WC_XCP_READ_ONLY (a production build): DOWNLOAD,
  * SET_CAL_PAGE and COPY_CAL_PAGE are removed (ERR_CMD_UNKNOWN); the
@@ -82,7 +92,7 @@
  * displaces a control frame; wc_xcp_init before the interrupt is enabled.
  * The cost of one wc_xcp_step is bounded: one command (a master waits for
  * each response; more queued frames wait for the next steps), one page
- * check, WC_XCP_DAQ_FRAMES_PER_STEP frames (README and
+ * check, WC_XCP_DAQ_FRAMES_PER_STEP frames (docs/results.md and
  * bench/arm_ceilings.txt give the instruction counts). */
 #ifndef WC_XCP_H
 #define WC_XCP_H
@@ -163,12 +173,17 @@ typedef struct {
     bool (*random)(void *context, uint8_t *seed, uint32_t seed_length);
     bool (*key)(void *context, const uint8_t *seed, uint32_t seed_length, uint8_t *key, uint32_t key_length);
     void *context;
+    uint32_t unlock_attempts;     /* 1..255 wrong keys in a row until the lock-out (with the hooks) */
+    uint32_t unlock_delay_steps;  /* the lock-out, 1..WC_XCP_UNLOCK_DELAY_MAX_STEPS control steps (with the hooks) */
 } wc_xcp_config_t;
 
-/* Unprotected (no hooks); 6-byte seed and key once hooks are set. */
+#define WC_XCP_UNLOCK_DELAY_MAX_STEPS 0x7FFFFFFFu
+
+/* Unprotected (no hooks); 6-byte seed and key once hooks are set; with them 3 wrong keys in a row lock
+ * GET_SEED out for 10000 control steps (10 s at the 1 ms period), as UDS SecurityAccess's default (wc_uds.h). */
 #define WC_XCP_CONFIG_DEFAULT                                                                          \
     { 0x00010000u, 0x00100000u, 0x00200000u, 0x00300000u, "wetclutch TCU", "wetclutch", false, 6u, 6u, \
-      NULL, NULL, NULL }
+      NULL, NULL, NULL, 3u, 10000u }
 
 /* What the master can read of the slave (UPLOAD, DAQ): the counters and the
  * last page check. */
@@ -223,6 +238,9 @@ typedef struct {
     uint8_t locked;                 /* resource bits still protected (GET_STATUS) */
     uint8_t seed_resource;          /* the resource of the seed sent; 0: no seed waits for its key */
     uint8_t seed[WC_XCP_SEED_MAX_BYTES];
+    uint32_t unlock_failures;       /* wrong keys in a row, across sessions (0 again at a right key, a lock-out's end) */
+    bool lockout;                   /* a lock-out was started ... */
+    uint32_t lockout_end;           /* ... and ends at this status.timestamp (no cost per step) */
     uint32_t mta;                   /* memory transfer address */
     /* DAQ */
     wc_xcp_daq_list_t lists[WC_XCP_DAQ_LISTS];
@@ -244,8 +262,9 @@ typedef struct {
  * from, wc_cal_image.h) and the controller on it, protected resources
  * locked. loop must be initialised (wc_loop_init) from that same
  * calibration. Returns false (slave unusable) on a NULL argument, a
- * reference that does not decode, one hook without the other, or a seed or
- * key length out of range. */
+ * reference that does not decode, one hook without the other, or (with the
+ * hooks) a seed or key length, unlock_attempts or unlock_delay_steps out of
+ * range. */
 bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payload, const wc_xcp_config_t *config);
 
 /* Queue one frame of the XcpCommand id (the port filters by id). Returns

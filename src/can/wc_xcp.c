@@ -140,7 +140,9 @@ bool wc_xcp_init(wc_xcp_t *xcp, wc_loop_t *loop, const uint8_t *reference_payloa
     if ((config->random == NULL) != (config->key == NULL)) { return false; }  /* half a protection: none */
     if ((config->random != NULL) &&
         ((config->seed_bytes == 0u) || (config->seed_bytes > WC_XCP_SEED_MAX_BYTES) || (config->key_bytes == 0u) ||
-         (config->key_bytes > WC_XCP_KEY_MAX_BYTES))) {
+         (config->key_bytes > WC_XCP_KEY_MAX_BYTES) || (config->unlock_attempts == 0u) ||
+         (config->unlock_attempts > 255u) || (config->unlock_delay_steps == 0u) ||
+         (config->unlock_delay_steps > WC_XCP_UNLOCK_DELAY_MAX_STEPS))) {
         return false;
     }
     xcp->config = *config;
@@ -570,6 +572,20 @@ static void relock(wc_xcp_t *x)
     memset(x->seed, 0, sizeof x->seed);
 }
 
+/* A lock-out runs (wc_xcp.h, failed attempts): the steps to its end, lockout_end - status.timestamp mod 2^32,
+ * are in (0, unlock_delay_steps]. At its end the count of wrong keys starts from 0. Looked at only here (no
+ * cost per step): a first GET_SEED 2^32 - unlock_delay_steps steps after the end (49.7 days at 1 ms) finds
+ * it running again, for at most unlock_delay_steps. */
+static bool locked_out(wc_xcp_t *x)
+{
+    if (!x->lockout) { return false; }
+    const uint32_t left_steps = x->lockout_end - x->status.timestamp;
+    if ((left_steps != 0u) && (left_steps <= x->config.unlock_delay_steps)) { return true; }
+    x->lockout = false;
+    x->unlock_failures = 0u;
+    return false;
+}
+
 static uint32_t get_seed(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
 {
     const uint32_t mode = cmd[1];
@@ -585,6 +601,7 @@ static uint32_t get_seed(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
         res[1] = 0u;  /* not protected (or unlocked already): seed length 0 */
         return XCP_OK;
     }
+    if (locked_out(x)) { return WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE; }  /* no seed, so no key to try */
     const uint32_t length = x->config.seed_bytes;
     if (!x->config.random(x->config.context, x->seed, length)) { return WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE; }
     x->seed_resource = (uint8_t)resource;
@@ -610,12 +627,18 @@ static uint32_t unlock(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc, uint8_t *r
     }
     good = good && (difference == 0u);
     memset(expected, 0, sizeof expected);
-    if (!good) {  /* the standard: ERR_ACCESS_LOCKED and back to disconnected */
+    if (!good) {  /* the standard: ERR_ACCESS_LOCKED and back to disconnected; counted, then the lock-out */
         daq_stop_all(x);
         x->connected = false;
         relock(x);
+        x->unlock_failures++;  /* at most unlock_attempts (<= 255): the lock-out's end resets it */
+        if (x->unlock_failures >= x->config.unlock_attempts) {
+            x->lockout = true;
+            x->lockout_end = x->status.timestamp + x->config.unlock_delay_steps;
+        }
         return WC_XCP_ERR_ACCESS_LOCKED;
     }
+    x->unlock_failures = 0u;
     x->locked &= (uint8_t)~resource;
     res[1] = x->locked;  /* the current resource protection status */
     return XCP_OK;

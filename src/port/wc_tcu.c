@@ -9,7 +9,8 @@
  * prints frames in/out, rejects by reason, timeouts, deadline misses and the
  * step-time max and percentiles, and optionally writes them as JSON.
  *   --uds          the diagnostic server (ISO-TP + UDS + fault memory,
- *                  wc_tcu_diag.h), stepped after the step's control frames */
+ *                  wc_tcu_diag.h), stepped after the step's control frames;
+ *                  an ECUReset restarts the loop at the end of its step */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <getopt.h>
@@ -135,15 +136,16 @@ static void usage(FILE *out)
             "                            and DAQ for a calibration tool (README: Calibration over XCP)\n"
             "      --uds                 UDS diagnostics over ISO-TP (UdsPhysicalRequest 0x7E1, UdsFunctionalRequest\n"
             "                            0x7DF, UdsResponse 0x7E9): identity, DIDs, DTCs, SecurityAccess, adaptation\n"
-            "                            reset routine; after the step's control frames, one frame a step by default\n"
+            "                            reset routine, ECUReset (soft: the loop restarts in its safe state); after\n"
+            "                            the step's control frames, one frame a step by default\n"
             "      --secret-file FILE    with --uds (required) or --xcp: the device secret (16..1024 bytes); the key\n"
             "                            of a seed is HMAC-SHA256(secret, seed), its first 16 bytes (UDS) or 6 bytes\n"
             "                            (XCP GET_SEED/UNLOCK: CAL/PAG locked until then; without it XCP is open)\n"
             "      --dtc-file FILE       with --uds: the fault memory's image, read at start (missing: empty;\n"
             "                            corrupt: empty and DTC 0x062F00) and written atomically on change and at exit\n"
             "      --serial TEXT         with --uds: the ECU serial number (DID 0xF18C; default WC0000000001)\n"
-            "      --security-delay-ms N with --uds: the SecurityAccess delay after 3 wrong keys and at start\n"
-            "                            (default 10000)\n"
+            "      --security-delay-ms N with --uds: the SecurityAccess delay after 3 wrong keys and at start; with\n"
+            "                            --xcp --secret-file: the GET_SEED lock-out after 3 wrong keys (default 10000)\n"
             "      --uds-frames-per-step N  with --uds: diagnostic frames sent per step at most (1..8, default 1)\n"
             "      --xcp-layout          print the XCP regions and the measured signals' addresses as JSON\n"
             "                            (for `wetclutch a2l`) and exit\n"
@@ -324,7 +326,7 @@ static const wc_calibration_t *find_calibration(const char *name)
  * encoded as an image payload (the same bytes an image file holds); with a
  * secret file, CAL/PAG behind seed & key, else open (said on stderr). */
 static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
-                     const char *secret_file)
+                     const char *secret_file, uint32_t lockout_steps)
 {
     static wc_cal_set_t set;
     static uint8_t reference[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
@@ -337,6 +339,7 @@ static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal
         xcp_config.random = wc_device_secret_random;   /* the key: HMAC-SHA256(secret, seed), its first bytes */
         xcp_config.key = wc_device_secret_key;
         xcp_config.context = &secret;
+        xcp_config.unlock_delay_steps = lockout_steps;  /* 3 wrong keys in a row (the default), then the lock-out */
     } else {
         fprintf(stderr, "wc_tcu: warning: --xcp without --secret-file: calibration writes are not protected"
                         " (no XCP seed & key)\n");
@@ -404,8 +407,36 @@ static void send_frames(wc_loop_t *loop, wc_socketcan_t *port, port_stats_t *ps,
     }
 }
 
-static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_tcu_diag_t *diag, wc_socketcan_t *port,
-               step_times_t *times, port_stats_t *ps)
+/* ECUReset softReset (UDS 0x11 0x03, wc_tcu_diag.h), at the end of the step after its response: the learned
+ * values and the fault memory persisted, a new operation cycle and restarted servers (wc_tcu_diag_reset),
+ * then the loop re-initialised on the calibration it runs (an XCP page's included: DESIGN 13) and started at
+ * --theta-start as at power-on: the safe state until its inputs have been fresh for recovery_periods
+ * (DESIGN 8). The learned values come back from their image (without --adaptation-file: as they were); the
+ * loop's counters are the program's statistics and carry over. */
+static void soft_reset(const options_t *opt, wc_loop_t *loop, wc_tcu_diag_t *diag, wc_adapt_file_t *adaptation_file)
+{
+    if (loop->config.adaptation_changed != NULL) {  /* written on every change; once more, as an ECU flushes */
+        loop->config.adaptation_changed(&loop->adapt, loop->config.adaptation_context);
+    }
+    wc_tcu_diag_reset(diag);
+    const wc_calibration_t *cal = loop->clutch.model.cal;
+    const wc_loop_config_t config = loop->config;
+    const wc_adapt_t learned = loop->adapt;
+    const wc_loop_counters_t counters = loop->counters;
+    if (wc_loop_init(loop, cal, &config, (float)opt->theta_start_degC) != WC_CAL_OK) {
+        fprintf(stderr, "wc_tcu: soft reset: the loop's own calibration refused (a bug)\n");  /* it ran on it */
+    }
+    if (adaptation_file != NULL) {
+        (void)wc_adapt_file_attach(adaptation_file, loop);
+    } else {
+        loop->adapt = learned;
+    }
+    loop->counters = counters;
+    loop->overflows_seen = counters.rejected[WC_REJECT_OVERFLOW];  /* not a new loss (wc_loop.c prepare) */
+}
+
+static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_tcu_diag_t *diag,
+               wc_adapt_file_t *adaptation_file, wc_socketcan_t *port, step_times_t *times, port_stats_t *ps)
 {
     int64_t last_rx = -1;  /* the idle timer starts with the first frame */
     const wc_loop_clock_t clock = opt->frame_clock ? WC_LOOP_CLOCK_FRAME : WC_LOOP_CLOCK_TIMER;
@@ -479,6 +510,7 @@ static int run(const options_t *opt, wc_loop_t *loop, wc_xcp_t *xcp, wc_tcu_diag
         if ((diag != NULL) && (n > 0u)) {  /* after the step's frames: the fault tests, then one server step */
             wc_can_frame_t dout[WC_TCU_DIAG_TX_FRAMES];
             send_frames(loop, port, ps, dout, wc_tcu_diag_step(diag, out, n, dout, WC_TCU_DIAG_TX_FRAMES));
+            if (wc_tcu_diag_reset_pending(diag)) { soft_reset(opt, loop, diag, adaptation_file); }
         }
     }
     if (timer_fd >= 0) { (void)close(timer_fd); }
@@ -570,7 +602,10 @@ int main(int argc, char **argv)
 
     /* The XCP slave: its reference page is the calibration the loop started with, as an image payload. */
     static wc_xcp_t xcp;
-    if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config, opt.secret_file) != 0)) { return 2; }
+    const uint64_t delay_us = (uint64_t)opt.security_delay_ms * 1000u;  /* the lock-out in whole steps, at least 1 */
+    const uint64_t period_us = (uint64_t)(opt.period_ns / 1000);
+    const uint32_t lockout_steps = (delay_us <= period_us) ? 1u : (uint32_t)((delay_us + period_us - 1u) / period_us);
+    if (opt.xcp && (start_xcp(&xcp, &loop, cal, &config, opt.secret_file, lockout_steps) != 0)) { return 2; }
 
     /* The diagnostic server: the calibration image the loop runs (its CRC is a DID), the fault memory. */
     static wc_tcu_diag_t diag;
@@ -607,7 +642,8 @@ int main(int argc, char **argv)
             opt.bench ? ", bench input ON (BenchMeasurement replaces the modelled force and heat input)" : "");
 
     port_stats_t ps = { 0u, 0u, 0u, 0 };
-    const int status = run(&opt, &loop, (opt.xcp != 0) ? &xcp : NULL, opt.uds ? &diag : NULL, &port, &times, &ps);
+    const int status = run(&opt, &loop, (opt.xcp != 0) ? &xcp : NULL, opt.uds ? &diag : NULL,
+                           (opt.adaptation_file != NULL) ? &adaptation_file : NULL, &port, &times, &ps);
     wc_socketcan_close(&port);
     if (opt.uds) { wc_tcu_diag_close(&diag); }
     report(stderr, 0, &loop.counters, ps.tx_errors, port.rx_dropped, &times);

@@ -190,6 +190,24 @@ static uint8_t reset_results(void *context, const uint8_t *option, uint32_t opti
     return 0u;
 }
 
+/* ---- ECUReset 0x11 softReset (ISO 14229-1:2013 9.3; wc_tcu_diag.h) ------------------------------------ */
+
+/* conditionsNotCorrect while a shift runs: a reset would release the clutch in the middle of a gear change */
+static uint8_t ecu_reset_check(void *context, uint8_t reset_type)
+{
+    const wc_tcu_diag_t *d = context;
+    (void)reset_type;
+    return wc_shift_phase_running(d->loop->shift.phase) ? (uint8_t)WC_UDS_NRC_CONDITIONS : 0u;
+}
+
+/* Called by wc_uds_step once the positive response is on the bus; the reset waits for the end of the step. */
+static void ecu_reset(void *context, uint8_t reset_type)
+{
+    wc_tcu_diag_t *d = context;
+    (void)reset_type;
+    d->ecu_reset_pending = true;
+}
+
 /* ---- security hooks: getrandom(2) and HMAC-SHA256 (OpenSSL) -------------------------------------------- */
 
 static bool key_of_seed(void *context, const uint8_t *seed, uint32_t seed_length, uint8_t *key, uint32_t key_length)
@@ -315,6 +333,8 @@ int wc_tcu_diag_open(wc_tcu_diag_t *d, const wc_tcu_diag_options_t *options, wc_
     u->dtc = &d->dtc;
     u->random = wc_device_secret_random;
     u->key = key_of_seed;
+    u->reset_check = ecu_reset_check;
+    u->reset = ecu_reset;
     u->context = d;
     if (!wc_uds_init(&d->uds, u)) {
         fprintf(stderr, "%s: --uds: the UDS configuration is refused (period %u us)\n", options->program,
@@ -396,13 +416,38 @@ uint32_t wc_tcu_diag_step(wc_tcu_diag_t *d, const wc_can_frame_t *loop_out, uint
     return frames;
 }
 
+bool wc_tcu_diag_reset_pending(const wc_tcu_diag_t *d) { return d->ecu_reset_pending; }
+
+void wc_tcu_diag_reset(wc_tcu_diag_t *d)
+{
+    d->ecu_reset_pending = false;
+    d->ecu_resets++;
+    wc_dtc_cycle_end(&d->dtc);  /* the operation cycle's end (wc_dtc.h: pending, healing, ageing) */
+    store_dtc(d);
+    if (d->options.dtc_file != NULL) {  /* the memory a restarted ECU finds: its image (without a file: as it is) */
+        const wc_dtc_config_t config = d->dtc.config;
+        (void)wc_dtc_init(&d->dtc, &config);  /* accepted at open */
+        load_dtc(d);
+    }
+    wc_dtc_cycle_start(&d->dtc);
+    d->inputs_started = false;  /* the restarted loop's inputs are stale until they come: no timeout test */
+    const wc_uds_counters_t uds_counters = d->uds.counters;
+    const wc_isotp_counters_t tp_counters = d->tp.counters;
+    const wc_isotp_config_t tp_config = d->tp.config;
+    (void)wc_uds_init(&d->uds, &d->uds_config);  /* default session, locked, the delay of a start; accepted at open */
+    (void)wc_isotp_init(&d->tp, &tp_config);
+    d->uds.counters = uds_counters;
+    d->tp.counters = tp_counters;
+    if (wc_dtc_changed(&d->dtc)) { store_dtc(d); }
+}
+
 void wc_tcu_diag_close(wc_tcu_diag_t *d)
 {
     wc_dtc_cycle_end(&d->dtc);
     store_dtc(d);
-    fprintf(stderr, "%s: uds: requests %u (positive %u, negative %u), invalid keys %u; iso-tp malformed %u,"
-                    " rx overflows %u; fault memory writes %lu (failed %lu)\n",
+    fprintf(stderr, "%s: uds: requests %u (positive %u, negative %u), invalid keys %u, soft resets %lu; iso-tp"
+                    " malformed %u, rx overflows %u; fault memory writes %lu (failed %lu)\n",
             d->options.program, d->uds.counters.requests, d->uds.counters.positive, d->uds.counters.negative,
-            d->uds.counters.invalid_keys, d->tp.counters.malformed, d->tp.counters.rx_overflows, d->dtc_writes,
-            d->dtc_write_failures);
+            d->uds.counters.invalid_keys, d->ecu_resets, d->tp.counters.malformed, d->tp.counters.rx_overflows,
+            d->dtc_writes, d->dtc_write_failures);
 }

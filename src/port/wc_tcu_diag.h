@@ -29,9 +29,22 @@
  * wc_loop_request_adaptation_reset, 0x22 when adaptation is off or a shift
  * runs; results: 1 byte, 0 done, 1 pending).
  *
+ * ECUReset (0x11) softReset 0x03, as an ECU does it (ISO 14229-1:2013 9.3):
+ * refused with 0x22 while a shift runs; else the positive response goes out
+ * first, and at the end of the step after it (wc_tcu_diag_reset_pending) the
+ * program restarts what a reset restarts: the learned values and the fault
+ * memory persisted, the operation cycle ended and a new one started
+ * (wc_dtc_cycle_end / _start: one reset is one operation cycle, like one
+ * wc_tcu run), the fault memory read back from its image, the UDS server
+ * and ISO-TP restarted (default session, locked, the security delay of a
+ * start: wc_uds.h delay_at_init), and the loop re-initialised on the
+ * calibration it runs (wc_tcu.c: the safe state, then the normal debounced
+ * recovery, DESIGN 8).
+ *
  * DTCs: the rows of the fault matrix (wc_tcu_diag.c, dtc_table). Each step
  * the VfsCommand status word the loop just produced reports every row's
- * test; an operation cycle is one wc_tcu run. */
+ * test; an operation cycle is one wc_tcu run, or the time between two
+ * soft resets. */
 #ifndef WC_TCU_DIAG_H
 #define WC_TCU_DIAG_H
 
@@ -79,6 +92,8 @@ typedef struct {
     uint32_t xcp_pages_rejected_seen;
     bool inputs_started;          /* both control inputs fresh once: the timeout tests run from then on */
     bool reset_requested;         /* routine 0x0201 started, not yet taken by the loop */
+    bool ecu_reset_pending;       /* ECUReset answered: the program resets at the end of this step */
+    unsigned long ecu_resets;     /* soft resets done */
     unsigned long dtc_writes;
     unsigned long dtc_write_failures;
 } wc_tcu_diag_t;
@@ -103,6 +118,16 @@ void wc_tcu_diag_receive(wc_tcu_diag_t *diag, const wc_can_frame_t *frame);
  * persists the fault memory when it changed. */
 uint32_t wc_tcu_diag_step(wc_tcu_diag_t *diag, const wc_can_frame_t *loop_out, uint32_t n, wc_can_frame_t *out,
                           uint32_t capacity);
+
+/* An ECUReset was answered (its response is on the bus): the caller resets
+ * at the end of this step, wc_tcu_diag_reset and the loop's restart. */
+bool wc_tcu_diag_reset_pending(const wc_tcu_diag_t *diag);
+
+/* The diagnostic half of a soft reset: the operation cycle ended and the
+ * fault memory persisted, read back from its image (kept as it is without
+ * --dtc-file), a new cycle started, the servers restarted (their counters
+ * kept), the timeout tests waiting for the inputs again. */
+void wc_tcu_diag_reset(wc_tcu_diag_t *diag);
 
 /* End of the operation cycle: the memory's cycle end, persisted. */
 void wc_tcu_diag_close(wc_tcu_diag_t *diag);

@@ -1,10 +1,10 @@
 /* Fault-injection matrix of the CAN frame loop with its default configuration
  * (timeout 10 periods, MaxDeltaCounter 2, SyncCounter 3, recovery 20
  * periods): for each fault, the period the loop reacts in, its output while
- * the fault lasts, and the period it recovers in, against the README's
- * safe-state table (DESIGN.md section 8). The loop runs on a timer clock
- * (one step per period whatever arrives), the sender is a well-behaved VCU
- * and sensor front end except for the injected fault.
+ * the fault lasts, and the period it recovers in, against the safe-state
+ * table of docs/integrating.md (DESIGN.md section 8). The loop runs on a
+ * timer clock (one step per period whatever arrives), the sender is a
+ * well-behaved VCU and sensor front end except for the injected fault.
  *
  * Periods are counted from 0; "reaction" is the number of periods from the
  * first faulty period to the first period with StatusSafeStateActive, and

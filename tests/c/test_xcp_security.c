@@ -8,6 +8,11 @@
  *    locked too with protect_daq, unlocked on its own;
  *  - a wrong key (or length): ERR_ACCESS_LOCKED and the session
  *    disconnected; the seed used once; DISCONNECT locks again;
+ *  - wrong keys counted across sessions, then a lock-out of
+ *    unlock_delay_steps control steps: GET_SEED of a protected resource
+ *    ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE (no seed, no key to try), the
+ *    writes ERR_ACCESS_LOCKED; a right key, and the lock-out's end, start the
+ *    count from 0;
  *  - GET_SEED's and UNLOCK's error classes, a failing random hook, the
  *    configurations init refuses.
  * Built twice: as test_xcp_security against the library, and as
@@ -35,6 +40,7 @@ typedef struct {
     wc_can_frame_t xout[WC_XCP_TX_FRAMES];
     uint8_t next_seed;      /* the random hook's counter */
     bool random_fails;
+    uint32_t random_calls;
     uint32_t key_calls;
 } rig_t;
 
@@ -43,6 +49,7 @@ static rig_t rig;
 static bool test_random(void *context, uint8_t *seed, uint32_t length)
 {
     rig_t *r = context;
+    r->random_calls++;
     if (r->random_fails) { return false; }
     for (uint32_t i = 0u; i < length; ++i) { seed[i] = r->next_seed++; }
     return true;
@@ -220,6 +227,109 @@ static void test_wrong_key_disconnects(void **state)
     assert_true(rig.xcp.connected);
 }
 
+#define LOCKOUT_ATTEMPTS 3u
+#define LOCKOUT_STEPS 5u
+
+/* n control steps of time (wc_xcp_step with control_step, no command) */
+static void control_steps(uint32_t n)
+{
+    for (uint32_t i = 0u; i < n; ++i) { assert_int_equal(wc_xcp_step(&rig.xcp, true, rig.xout), 0u); }
+}
+
+/* CONNECT (if not connected) and one wrong key: ERR_ACCESS_LOCKED, disconnected */
+static void wrong_key(void)
+{
+    if (!rig.xcp.connected) { EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u); }
+    seed_and_key(WC_XCP_RESOURCE_CAL_PAG, 0x01u);
+    EXPECT_ERR(1u, WC_XCP_ERR_ACCESS_LOCKED);
+    assert_false(rig.xcp.connected);
+}
+
+static wc_xcp_config_t lockout_config(void)
+{
+    wc_xcp_config_t c = protected_config(false);
+    c.unlock_attempts = LOCKOUT_ATTEMPTS;
+    c.unlock_delay_steps = LOCKOUT_STEPS;
+    return c;
+}
+
+static void test_wrong_keys_counted_then_locked_out(void **state)
+{
+    (void)state;
+    const wc_xcp_config_t config = lockout_config();
+    rig_init(&config);
+    wrong_key();  /* the count survives the disconnect a wrong key makes ... */
+    wrong_key();
+    assert_int_equal(rig.xcp.unlock_failures, 2u);
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);  /* ... and a DISCONNECT and a new CONNECT */
+    EXPECT_OK(SEND(WC_XCP_DISCONNECT), 0u);
+    wrong_key();  /* the third: the lock-out */
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    const uint32_t random_calls = rig.random_calls;
+    EXPECT_ERR(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE);
+    EXPECT_ERR(SEND(WC_XCP_UNLOCK, 6u, 0u, 0u, 0u, 0u, 0u, 0u), WC_XCP_ERR_SEQUENCE);  /* no seed: no key to try */
+    EXPECT_WRITE_LOCKED(download_same_byte());
+    EXPECT_OK(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_DAQ), 0u);  /* not protected here: length 0 */
+    assert_true(rig.xcp.connected);
+    /* time is control steps: commands without one do not shorten it */
+    for (uint32_t i = 0u; i < 2u * LOCKOUT_STEPS; ++i) {
+        EXPECT_ERR(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE);
+    }
+    control_steps(LOCKOUT_STEPS - 1u);
+    EXPECT_ERR(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE);
+    assert_int_equal(rig.random_calls, random_calls);  /* not one seed in the lock-out */
+    control_steps(1u);
+    seed_and_key(WC_XCP_RESOURCE_CAL_PAG, 0u);  /* over: a seed, and the right key unlocks */
+    EXPECT_OK(1u, 0u);
+    EXPECT_WRITE_OK(download_same_byte());
+    assert_int_equal(rig.xcp.unlock_failures, 0u);
+}
+
+static void test_count_starts_again(void **state)
+{
+    (void)state;
+    const wc_xcp_config_t config = lockout_config();
+    rig_init(&config);
+    /* a right key resets the count: two wrong, the right one, two wrong again: no lock-out */
+    wrong_key();
+    wrong_key();
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    seed_and_key(WC_XCP_RESOURCE_CAL_PAG, 0u);
+    EXPECT_OK(1u, 0u);
+    EXPECT_OK(SEND(WC_XCP_DISCONNECT), 0u);
+    wrong_key();
+    wrong_key();
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    assert_int_equal(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), 1u);
+    assert_int_equal(rig.xout[0].data[0], 0xFFu);  /* a seed */
+    /* the lock-out's end does too: three wrong, waited out, then three wrong again lock out again */
+    EXPECT_OK(SEND(WC_XCP_DISCONNECT), 0u);
+    wrong_key();
+    control_steps(LOCKOUT_STEPS);
+    wrong_key();
+    wrong_key();
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    assert_int_equal(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), 1u);
+    assert_int_equal(rig.xout[0].data[0], 0xFFu);  /* two since the end: no lock-out */
+    EXPECT_OK(SEND(WC_XCP_DISCONNECT), 0u);
+    wrong_key();
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    EXPECT_ERR(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE);
+    /* the step counter wraps (2^32 control steps): the lock-out still ends after its steps */
+    const wc_xcp_config_t again = lockout_config();
+    rig_init(&again);
+    rig.xcp.status.timestamp = 0xFFFFFFFEu;
+    wrong_key();
+    wrong_key();
+    wrong_key();
+    EXPECT_OK(SEND(WC_XCP_CONNECT, 0u), 0x05u);
+    control_steps(LOCKOUT_STEPS - 1u);
+    EXPECT_ERR(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), WC_XCP_ERR_RESOURCE_TEMPORARY_NOT_ACCESSIBLE);
+    control_steps(1u);
+    assert_int_equal(SEND(WC_XCP_GET_SEED, 0u, WC_XCP_RESOURCE_CAL_PAG), 1u);
+    assert_int_equal(rig.xout[0].data[0], 0xFFu);
+}
+
 static void test_daq_protected_by_config(void **state)
 {
     (void)state;
@@ -279,9 +389,23 @@ static void test_init_refuses_half_protection(void **state)
         c.key_bytes = bad[i][1];
         assert_false(wc_xcp_init(&rig.xcp, &rig.loop, rig.reference, &c));
     }
+    static const uint32_t bad_lockout[][2] = { { 0u, 10u }, { 256u, 10u }, { 3u, 0u },
+                                               { 3u, WC_XCP_UNLOCK_DELAY_MAX_STEPS + 1u } };
+    for (uint32_t i = 0u; i < sizeof bad_lockout / sizeof bad_lockout[0]; ++i) {
+        c = protected_config(false);
+        c.unlock_attempts = bad_lockout[i][0];
+        c.unlock_delay_steps = bad_lockout[i][1];
+        assert_false(wc_xcp_init(&rig.xcp, &rig.loop, rig.reference, &c));
+    }
     c = protected_config(false);
     c.seed_bytes = WC_XCP_SEED_MAX_BYTES;
     c.key_bytes = 1u;
+    c.unlock_attempts = 255u;
+    c.unlock_delay_steps = WC_XCP_UNLOCK_DELAY_MAX_STEPS;
+    assert_true(wc_xcp_init(&rig.xcp, &rig.loop, rig.reference, &c));
+    c = (wc_xcp_config_t)WC_XCP_CONFIG_DEFAULT;  /* without the hooks the attempts are not looked at */
+    c.unlock_attempts = 0u;
+    c.unlock_delay_steps = 0u;
     assert_true(wc_xcp_init(&rig.xcp, &rig.loop, rig.reference, &c));
 }
 
@@ -291,6 +415,8 @@ int main(void)
         cmocka_unit_test(test_no_hooks_nothing_protected),
         cmocka_unit_test(test_cal_pag_locked_until_unlock),
         cmocka_unit_test(test_wrong_key_disconnects),
+        cmocka_unit_test(test_wrong_keys_counted_then_locked_out),
+        cmocka_unit_test(test_count_starts_again),
         cmocka_unit_test(test_daq_protected_by_config),
         cmocka_unit_test(test_seed_errors),
         cmocka_unit_test(test_init_refuses_half_protection),

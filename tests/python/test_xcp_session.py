@@ -100,7 +100,7 @@ def _old_and_new_current(messages) -> tuple[float, list[float]]:
 def test_new_holding_margin_in_vfs_command(session):
     """VfsCommand (1/32 mA) held the locked clutch at table1's margin, then at the downloaded one:
     F_new / F_old = (1 + 0.5) / (1 + 0.2), F = K i A_p - F_s. That the change comes in the step after the
-    page's check is tests/c/test_xcp.c's (the emulated guest's capture misses frames under this load)."""
+    page's check is tests/c/test_xcp_calibration.c's (the emulated guest's capture misses frames under this load)."""
     _, r, messages = session
     assert r["after_download"] == {"page_result": 0, "accepted": 1, "margin": 0.5}
     old, after = _old_and_new_current(messages)

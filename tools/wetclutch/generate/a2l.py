@@ -7,7 +7,7 @@ host offsets of the slave's address space, src/can/wc_xcp.h) and each signal's `
     wetclutch a2l [--tcu PATH | --layout FILE] --out FILE.a2l
 
 No IF_DATA XCP block: the transport (CAN ids 0x7F0/0x7F1 from the DBC, classic CAN, MAX_CTO = MAX_DTO = 8)
-is given to the master by its own configuration (README, "Calibration over XCP")."""
+is given to the master by its own configuration (docs/calibrating.md, "XCP on CAN")."""
 from __future__ import annotations
 
 import json
