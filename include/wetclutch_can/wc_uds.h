@@ -12,8 +12,10 @@
  *   0x11 ECUReset (9.3): 0x03 softReset only (0x01 hardReset and the others
  *        are not supported: 0x12; the library cannot emulate a power cycle).
  *        The integrator's reset_check may refuse (its NRC, e.g. 0x22 while
- *        the vehicle moves); the reset hook runs once the response has been
- *        handed to the port (wc_uds_step), or at once when suppressed.
+ *        the vehicle moves); the reset hook runs in the wc_uds_step that
+ *        hands the response's last frame to the port (or, suppressed, in the
+ *        next one): the port sends the step's frames, then resets, so no
+ *        request reaches the server between the response and the reset.
  *   0x14 ClearDiagnosticInformation (11.2): group 0xFFFFFF or one DTC
  *        number; security.
  *   0x19 ReadDTCInformation (11.3): 0x01 reportNumberOfDTCByStatusMask,
@@ -194,9 +196,10 @@ uint32_t wc_uds_handle(wc_uds_t *uds, const uint8_t *request, uint32_t length, b
 /* One control period of time: S3 and the security delay. */
 void wc_uds_tick(wc_uds_t *uds);
 
-/* One control step of the whole server: a pending reset hook (its response
- * is out), wc_uds_tick, wc_isotp_step (frames to out, returns their count)
- * and the request that completed, answered through tp. */
+/* One control step of the whole server: wc_uds_tick, wc_isotp_step (frames
+ * to out, returns their count), then a pending reset hook once its response
+ * is in out (no request served in that step), else the request that
+ * completed, answered through tp. */
 uint32_t wc_uds_step(wc_uds_t *uds, wc_isotp_t *tp, wc_can_frame_t *out, uint32_t capacity);
 
 uint8_t wc_uds_session(const wc_uds_t *uds);

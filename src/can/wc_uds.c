@@ -402,15 +402,19 @@ uint32_t wc_uds_step(wc_uds_t *uds, wc_isotp_t *tp, wc_can_frame_t *out, uint32_
 {
     WC_ASSERT((uds != NULL) && uds->initialised && (tp != NULL) && (out != NULL));
     if ((uds == NULL) || !uds->initialised || (tp == NULL) || (out == NULL)) { return 0u; }
-    if ((uds->reset_type != 0u) && !wc_isotp_sending(tp)) {  /* its response went to the port last step */
+    wc_uds_tick(uds);
+    const uint32_t n = wc_isotp_step(tp, out, capacity);
+    if (wc_isotp_sending(tp)) { uds->s3_left_steps = uds->s3_steps; }  /* a response in flight keeps the session */
+    if ((uds->reset_type != 0u) && !wc_isotp_sending(tp)) {
+        /* the reset's response is in out (its last frame) or was suppressed: the hook runs now, so that the
+         * port sends the response and then resets within this step, and no request can reach the server
+         * between the two (a tester's next request, sent on the response, would be lost in the reset) */
         const uint8_t type = uds->reset_type;
         uds->reset_type = 0u;
         uds->counters.resets++;
         uds->config->reset(uds->config->context, type);
+        return n;  /* a request completed meanwhile is the reset's to drop, not to serve */
     }
-    wc_uds_tick(uds);
-    const uint32_t n = wc_isotp_step(tp, out, capacity);
-    if (wc_isotp_sending(tp)) { uds->s3_left_steps = uds->s3_steps; }  /* a response in flight keeps the session */
     uint32_t length = 0u;
     bool functional = false;
     const uint8_t *request = wc_isotp_request(tp, &length, &functional);

@@ -407,7 +407,7 @@ static void send_frames(wc_loop_t *loop, wc_socketcan_t *port, port_stats_t *ps,
     }
 }
 
-/* ECUReset softReset (UDS 0x11 0x03, wc_tcu_diag.h), at the end of the step after its response: the learned
+/* ECUReset softReset (UDS 0x11 0x03, wc_tcu_diag.h), at the end of the step that sends its response: the learned
  * values and the fault memory persisted, a new operation cycle and restarted servers (wc_tcu_diag_reset),
  * then the loop re-initialised on the calibration it runs (an XCP page's included: DESIGN 13) and started at
  * --theta-start as at power-on: the safe state until its inputs have been fresh for recovery_periods

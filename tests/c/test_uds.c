@@ -416,10 +416,12 @@ static void test_ecu_reset_after_the_response(void **state)
     assert_int_equal(fake.resets, 0u);
     assert_int_equal(server_step(), 1u);
     assert_memory_equal(frames[0].data, BYTES(0x02, 0x51, 0x03, 0xCC, 0xCC, 0xCC, 0xCC, 0xCC), 8u);
-    assert_int_equal(fake.resets, 0u);    /* the port queues the frame after this step */
-    assert_int_equal(server_step(), 0u);
-    assert_int_equal(fake.resets, 1u);
+    assert_int_equal(fake.resets, 1u);    /* in the step that hands the response out: the port sends, then resets */
     assert_int_equal(fake.reset_type, WC_UDS_RESET_SOFT);
+    FRAME_IN(0x02, 0x3E, 0x00);           /* the tester's next request, sent on the response: after the reset */
+    assert_int_equal(server_step(), 0u);
+    assert_int_equal(server_step(), 1u);
+    assert_memory_equal(frames[0].data, BYTES(0x02, 0x7E, 0x00, 0xCC, 0xCC, 0xCC, 0xCC, 0xCC), 8u);
     assert_int_equal(server_step(), 0u);
     assert_int_equal(fake.resets, 1u);    /* once */
     FRAME_IN(0x02, 0x11, 0x83);           /* suppressed: at the next step */

@@ -149,7 +149,7 @@ def test_diagnostics_never_displace_a_control_frame(session):
 
 
 def test_soft_reset(session):
-    """ECUReset softReset: answered first; at the end of the step after the answer the loop restarts (its
+    """ECUReset softReset: answered first; at the end of the step that sends the answer the loop restarts (its
     VfsCommand counter from 0, the safe state for the recovery debounce, then control again; the captured
     session's inputs come every period, so 19 safe steps and the 20th controls) and the server
     as after a start (default session, locked, the start's security delay); the operation cycle ends
@@ -163,9 +163,11 @@ def test_soft_reset(session):
     vfs = canlog.database().get_message_by_name("VfsCommand")
     answer = next(i for i, m in enumerate(messages) if m.arbitration_id == UDS_RESPONSE and bytes(m.data[:3]) == b"\x02\x51\x03")
     after = [vfs.decode(bytes(m.data)) for m in messages[answer:] if m.arbitration_id == VFS]
-    assert int(after[1]["AliveCounter"]) == 0    # after[0]: the step in which the reset ran, still the old loop
+    # the reset ran at the end of the answer's step: the next VfsCommand is the new loop's first (no request
+    # can reach the server between the answer and the reset)
+    assert int(after[0]["AliveCounter"]) == 0
     # both inputs come every period: fresh from the first step, which counts as the debounce's first period
-    safe = [int(v["StatusSafeStateActive"]) == 1 for v in after[1:]]
+    safe = [int(v["StatusSafeStateActive"]) == 1 for v in after]
     assert all(safe[:RECOVERY_PERIODS - 1]) and not any(safe[RECOVERY_PERIODS - 1:RECOVERY_PERIODS + 50])
 
 
