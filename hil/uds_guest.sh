@@ -31,9 +31,9 @@ tester=("$repo/.venv/bin/python" "$repo/hil/uds_tester.py" --secret "$dir/secret
 record=(--record capture.log --record-id 0x110 --record-id 0x120 --record-id 0x123 --record-id 0x7DF
         --record-id 0x7E1 --record-id 0x7E9)
 # a short security delay (200 steps): the session waits it out at start, after a soft reset and after three
-# wrong keys
+# wrong keys; DTCs age out after 5 fault-free cycles (the restart phase counts them with soft resets)
 tcu_args=(--uds --secret-file "$dir/secret.key" --dtc-file "$dir/dtc.img" --serial WC0000004711
-          --security-delay-ms 200 --calibration-image "$dir/cal.img" --adaptation-file "$dir/adapt.img"
+          --security-delay-ms 200 --dtc-aging-cycles 5 --calibration-image "$dir/cal.img" --adaptation-file "$dir/adapt.img"
           --theta-start 60 --stats-json stats.json)
 
 guest_start_tcu "${tcu_args[@]}"

@@ -69,6 +69,7 @@ typedef struct {
     const char *dtc_file;     /* --dtc-file: the fault memory's image */
     const char *serial;       /* --serial: DID 0xF18C */
     unsigned security_delay_ms;  /* --security-delay-ms */
+    unsigned dtc_aging_cycles;   /* --dtc-aging-cycles */
     unsigned uds_frames_per_step;  /* --uds-frames-per-step */
 } options_t;
 
@@ -147,6 +148,8 @@ static void usage(FILE *out)
             "      --security-delay-ms N with --uds: the SecurityAccess delay after 3 wrong keys and at start; with\n"
             "                            --xcp --secret-file: the GET_SEED lock-out after 3 wrong keys (default 10000)\n"
             "      --uds-frames-per-step N  with --uds: diagnostic frames sent per step at most (1..8, default 1)\n"
+            "      --dtc-aging-cycles N  with --uds: fault-free operation cycles until a confirmed DTC ages out\n"
+            "                            (1..255, default 40; a run or a soft reset is one cycle)\n"
             "      --xcp-layout          print the XCP regions and the measured signals' addresses as JSON\n"
             "                            (for `wetclutch a2l`) and exit\n"
             "  -j, --stats-json FILE     also write the exit statistics as JSON\n"
@@ -205,9 +208,10 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"uds", no_argument, NULL, 8},                 {"secret-file", required_argument, NULL, 9},
         {"dtc-file", required_argument, NULL, 10},     {"serial", required_argument, NULL, 11},
         {"security-delay-ms", required_argument, NULL, 12}, {"uds-frames-per-step", required_argument, NULL, 13},
+        {"dtc-aging-cycles", required_argument, NULL, 14},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
-                     .sensor_timeout = 10u, .request_timeout = 10u, .security_delay_ms = 10000u,
+                     .sensor_timeout = 10u, .request_timeout = 10u, .security_delay_ms = 10000u, .dtc_aging_cycles = 40u,
                      .uds_frames_per_step = 1u};
     double v = 0.0;
     int c;
@@ -237,6 +241,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 10: o->dtc_file = optarg; break;
         case 11: o->serial = optarg; break;
         case 12: if (parse_number(optarg, "--security-delay-ms", 0, 3600000, &v)) { return -1; } o->security_delay_ms = (unsigned)v; break;
+        case 14: if (parse_number(optarg, "--dtc-aging-cycles", 1, 255, &v)) { return -1; } o->dtc_aging_cycles = (unsigned)v; break;
         case 13: if (parse_number(optarg, "--uds-frames-per-step", 1, WC_ISOTP_MAX_FRAMES_PER_STEP, &v)) { return -1; } o->uds_frames_per_step = (unsigned)v; break;
         case 1: if (parse_number(optarg, "--sensor-timeout", 1, 1e6, &v)) { return -1; } o->sensor_timeout = (unsigned)v; o->compiled_in_given = 1; break;
         case 2: if (parse_number(optarg, "--request-timeout", 1, 1e6, &v)) { return -1; } o->request_timeout = (unsigned)v; o->compiled_in_given = 1; break;
@@ -618,7 +623,7 @@ int main(int argc, char **argv)
         }
         const wc_tcu_diag_options_t diag_options = {
             "wc_tcu", opt.secret_file, opt.dtc_file, opt.serial, (uint32_t)(opt.period_ns / 1000),
-            opt.security_delay_ms, opt.uds_frames_per_step };
+            opt.security_delay_ms, opt.uds_frames_per_step, opt.dtc_aging_cycles };
         if (wc_tcu_diag_open(&diag, &diag_options, &loop, opt.xcp ? &xcp : NULL, cal_image, cal_image_length) != 0) {
             return 2;
         }

@@ -54,7 +54,6 @@ static const uint16_t dtc_status_bit[DTC_COUNT] = {
     [DTC_OVER_TEMPERATURE] = WC_CAN_STATUS_OVER_TEMPERATURE,
     [DTC_DEADLINE_MISS] = WC_CAN_STATUS_DEADLINE_MISS,
 };
-#define DTC_AGING_CYCLES 40u
 
 #define DID_SERIAL 0xF18Cu
 #define DID_SOFTWARE_VERSION 0xF195u
@@ -300,7 +299,7 @@ int wc_tcu_diag_open(wc_tcu_diag_t *d, const wc_tcu_diag_options_t *options, wc_
     d->cal_image_crc32 = wc_image_get_u32(cal_image + cal_image_length - WC_IMAGE_CRC_BYTES);
     d->cal_layout_version = wc_image_get_u32(cal_image + 4u);
 
-    const wc_dtc_config_t dtc_config = { dtc_table, DTC_COUNT, DTC_AGING_CYCLES, DTC_MEMORY_LOST, &d->environment };
+    const wc_dtc_config_t dtc_config = { dtc_table, DTC_COUNT, options->dtc_aging_cycles, DTC_MEMORY_LOST, &d->environment };
     if (!wc_dtc_init(&d->dtc, &dtc_config)) {
         fprintf(stderr, "%s: --uds: the DTC table is refused (a bug)\n", options->program);
         return -1;

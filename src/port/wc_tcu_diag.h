@@ -72,6 +72,7 @@ typedef struct {
     uint32_t period_us;           /* the control period */
     uint32_t security_delay_ms;   /* after max attempts, and after start */
     uint32_t frames_per_step;     /* diagnostic frames sent per step at most */
+    uint32_t dtc_aging_cycles;    /* fault-free operation cycles until a confirmed DTC ages out (1..255) */
 } wc_tcu_diag_options_t;
 
 typedef struct {
