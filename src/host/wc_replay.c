@@ -3,11 +3,21 @@
  *   wc_replay LOG [--bench] [--calibration NAME] [--theta-start DEGC]
  *             [--shift NAME [--set FIELD=VALUE]...] [--lockstep]
  *   wc_replay LOG [--bench] --calibration-image FILE [--theta-start DEGC] [--lockstep]
+ *   ... [--offgoing-calibration-image FILE]
  *
  * --calibration-image: the whole calibration (clutch, shift control, loop
  * timeouts and E2E) from an image file (wc_cal_image.h, `wetclutch
  * cal-image`), as wc_tcu --calibration-image; a refused image: one line,
  * exit 2. Not with --calibration, --shift or --set.
+ *
+ * --offgoing-calibration-image: the whole shift's off-going clutch (DESIGN
+ * 14, wc_loop_config_t.offgoing) from an image of its own that carries one
+ * clutch (shift control off: its shift and loop parts are not used, so the
+ * image says so); without it the off-going clutch is an instance of the
+ * on-coming one's calibration. Needs shift control with the coordinator
+ * (--shift NAME or an image with it on); a refused image: exit 2. The
+ * 8-speed's shifts give each element its own clutch this way
+ * (tools/wetclutch/shift/matrix8.py).
  *
  * LOG "-" reads standard input. --shift turns shift control on with a
  * compiled-in shift calibration (as wc_tcu --shift); --set overrides one of
@@ -138,6 +148,7 @@ static int write_stats(const char *path, const wc_loop_counters_t *counters)
               " [--shift NAME [--set FIELD=VALUE]... [--adaptation-file FILE]] [--lockstep]\n" \
               "       wc_replay LOG|- [--bench] --calibration-image FILE [--theta-start DEGC] [--adaptation-file FILE]" \
               " [--lockstep]\n" \
+              "       --offgoing-calibration-image FILE: the whole shift's off-going clutch (an image, shift off)\n" \
               "       --stats-json FILE: the loop's counters at the end, as wc_tcu --stats-json writes them\n"
 
 int main(int argc, char **argv)
@@ -150,6 +161,7 @@ int main(int argc, char **argv)
     const char *stats_path = NULL;  /* --stats-json */
     const char *calibration = "table1";
     const char *image_path = NULL;  /* --calibration-image */
+    const char *offgoing_image_path = NULL;  /* --offgoing-calibration-image */
     int calibration_given = 0;
     int bench = 0;
     double theta_start_degC = 40.0;  /* as wc_tcu --theta-start */
@@ -180,6 +192,10 @@ int main(int argc, char **argv)
         else if ((strcmp(argv[i], "--calibration") == 0) && (i + 1 < argc)) { calibration = argv[++i]; calibration_given = 1; }
         else if ((strcmp(argv[i], "--calibration-image") == 0) && (i + 1 < argc) && (image_path == NULL)) {
             image_path = argv[++i];
+        }
+        else if ((strcmp(argv[i], "--offgoing-calibration-image") == 0) && (i + 1 < argc) &&
+                 (offgoing_image_path == NULL)) {
+            offgoing_image_path = argv[++i];
         }
         else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
                  ((void)(theta_start_degC = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0')) &&
@@ -229,6 +245,21 @@ int main(int argc, char **argv)
             return 2;
         }
         config.shift = &shift;
+    }
+    static wc_cal_set_t offgoing_image;  /* --offgoing-calibration-image: the loop keeps a pointer into it */
+    if (offgoing_image_path != NULL) {
+        if ((config.shift == NULL) || (config.shift->coordinator != 1u)) {
+            fprintf(stderr, "wc_replay: --offgoing-calibration-image needs shift control with the coordinator (the"
+                            " whole shift): --shift NAME or an image with it\n");
+            return 2;
+        }
+        if (wc_cal_image_file_load(offgoing_image_path, "wc_replay", &offgoing_image) != 0) { return 2; }
+        if (offgoing_image.shift_enabled) {
+            fprintf(stderr, "wc_replay: --offgoing-calibration-image %s: carries shift control; the off-going"
+                            " clutch's image holds its clutch alone (shift off)\n", offgoing_image_path);
+            return 2;
+        }
+        config.offgoing = &offgoing_image.clutch;
     }
     if ((config.shift != NULL) && (config.shift->coordinator == 1u) && (config.offgoing == NULL)) {
         config.offgoing = cal;  /* DESIGN 14: the off-going clutch has the same lining (its own instance) */

@@ -54,6 +54,10 @@ comparison  the matrix x controllers, the feedback gains' search, the targets, t
 plots       the Fig. 4-style panels of a scenario (plot_case; plot_whole_case: both clutches and the engine)
 whole       the whole shift (issue 22, DESIGN 14): the vehicle family, its scenarios and faults, targets, report
 vehicle_cal the TCU's driveline model of each vehicle plant (`wetclutch vehicle-cal`)
+matrix8     the 8-speed's power-on upshifts (issue 29 item 5): each element its own clutch as an equivalent clutch
+            in the controller's coordinates, wc_replay on two images, the plant's truth; run_upshift (not imported
+            here: it loads the 8-speed plant)
+matrix8_report  the matrix 1->2 ... 7->8 x loads x vehicles, its markdown and JSON
 """
 from __future__ import annotations
 
