@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..util.tomlfile import read_toml
+from ..util.tomlfile import extends_path, read_toml
 from .description import GearboxError
 
 # (name in [driveline], unit)
@@ -62,16 +62,9 @@ def _driveline(path: Path, chain: tuple) -> dict:
     table = doc.get("driveline", {})
     if not isinstance(table, dict):
         raise GearboxError(f"{path}: 'driveline' must be a table of parameters")
-    base_entry = doc.get("extends")
-    if base_entry is None:
+    base_path = extends_path(path, doc, chain, GearboxError)
+    if base_path is None:
         return dict(table)
-    if not isinstance(base_entry, str) or not base_entry.strip():
-        raise GearboxError(f"{path}: 'extends' must be the path of a base plant file (relative to this file)")
-    base_path = (path.parent / base_entry).resolve()
-    if base_path in chain:
-        raise GearboxError(f"{path}: 'extends' loop: {' -> '.join(str(c) for c in chain + (base_path,))}")
-    if not base_path.is_file():
-        raise GearboxError(f"{path}: 'extends': base plant file {base_path} not found")
     return {**_driveline(base_path, chain + (base_path,)), **table}
 
 

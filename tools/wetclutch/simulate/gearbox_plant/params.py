@@ -36,7 +36,7 @@ import numpy as np
 from ... import gearbox as gearbox_pkg
 from ...calibration import Calibration, CalibrationError, load as load_calibration
 from ...reference import model
-from ...util.tomlfile import read_toml
+from ...util.tomlfile import extends_path, read_toml
 from ..plant import PlantError, PlantParams, load_plant
 
 RPM = model.RAD_S_PER_RPM
@@ -114,16 +114,9 @@ def _read_doc(path: Path, chain: tuple) -> dict:
     truth = doc.get("truth")
     if isinstance(truth, dict) and isinstance(truth.get("calibration"), str) and truth["calibration"].strip():
         truth["calibration"] = str((path.parent / truth["calibration"]).resolve())
-    base_entry = doc.pop("extends", None)
-    if base_entry is None:
+    base_path = extends_path(path, doc, chain, PlantError)
+    if base_path is None:
         return doc
-    if not isinstance(base_entry, str) or not base_entry.strip():
-        raise PlantError(f"{path}: 'extends' must be the path of a base plant file (relative to this file)")
-    base_path = (path.parent / base_entry).resolve()
-    if base_path in chain:
-        raise PlantError(f"{path}: 'extends' loop: {' -> '.join(str(c) for c in chain + (base_path,))}")
-    if not base_path.is_file():
-        raise PlantError(f"{path}: 'extends': base plant file {base_path} not found")
     base = _read_doc(base_path, chain + (base_path,))
     for key, value in doc.items():
         if isinstance(value, dict) and isinstance(base.get(key), dict):

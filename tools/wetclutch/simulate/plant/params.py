@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ... import calibration
 from ...reference import model
-from ...util.tomlfile import read_toml
+from ...util.tomlfile import extends_path, read_toml
 
 
 RPM = model.RAD_S_PER_RPM          # rad/s per rpm
@@ -198,16 +198,10 @@ def _read_doc(path: Path, chain: tuple) -> dict:
         table = doc.get(section)
         if isinstance(table, dict) and isinstance(table.get(key), str) and table[key].strip():
             table[key] = str((path.parent / table[key]).resolve())
-    base_entry = doc.pop("extends", None)
-    if base_entry is None:
+    base_entry = doc.get("extends")
+    base_path = extends_path(path, doc, chain, PlantError)
+    if base_path is None:
         return doc
-    if not isinstance(base_entry, str) or not base_entry.strip():
-        raise PlantError(f"{where}: 'extends' must be the path of a base plant file (relative to this file)")
-    base_path = (path.parent / base_entry).resolve()
-    if base_path in chain:
-        raise PlantError(f"{where}: 'extends' loop: {' -> '.join(str(c) for c in chain + (base_path,))}")
-    if not base_path.is_file():
-        raise PlantError(f"{where}: 'extends': base plant file {base_path} not found")
     try:
         base = _read_doc(base_path, chain + (base_path,))
     except PlantError as e:
