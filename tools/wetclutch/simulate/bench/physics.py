@@ -81,6 +81,13 @@ class _Physics:
         static = (self.static_factor * self.rn * self.mu2) * temp * f_c                     # DESIGN 9
         return coulomb + viscous, coulomb, viscous, f_c, hbar, static
 
+    def contact(self, h: float) -> tuple[float, float]:
+        """(F_c, h_bar) at one separation h, in scalar math: the per-step form the plants' clutches use."""
+        x = h * self.inv_s_sqrt2
+        ex = math.exp(-x * x)
+        return (self.pc_area * (ex - h * self.pc_lin * math.erfc(x)),                       # eq. 15
+                0.5 * h * (1.0 + math.erf(x)) + self.hbar_k * ex)                           # eq. 9
+
     def film_rate(self, h, f_app, rate_mu):
         """dh/dt from the Reynolds force balance F_app = F_c(h) + F_h, F_h = phi 3 pi mu_v K / (2 h_bar^3) (-dh_bar/dt),
         dh_bar/dh = (1 + erf x) / 2; rate_mu = rate_k / mu_v."""

@@ -109,10 +109,7 @@ class TrueElement:
 
     def _set_film(self, h):
         ph = self._ph
-        x = h * ph.inv_s_sqrt2
-        ex = math.exp(-x * x)
-        self.f_c = ph.pc_area * (ex - h * ph.pc_lin * math.erfc(x))
-        self.hbar = 0.5 * h * (1.0 + math.erf(x)) + ph.hbar_k * ex
+        self.f_c, self.hbar = ph.contact(h)
         self.static = self.scale * ph.static_factor * ph.rn * ph.mu2 * self.temp * self.f_c
         self.coul_k = self.scale * ph.rn * self.temp * self.f_c
         self._set_open()

@@ -174,10 +174,7 @@ class UpshiftPlant:
     def _set_film(self, h):
         """F_c, h_bar and the static capacity at separation h (eq. 9, 15; DESIGN 9)."""
         ph = self._ph
-        x = h * ph.inv_s_sqrt2
-        ex = math.exp(-x * x)
-        self.f_c = ph.pc_area * (ex - h * ph.pc_lin * math.erfc(x))
-        self.hbar = 0.5 * h * (1.0 + math.erf(x)) + ph.hbar_k * ex
+        self.f_c, self.hbar = ph.contact(h)
         self.on_static = self.friction_scale * ph.static_factor * ph.rn * ph.mu2 * self.temp * self.f_c
         self.coul_k = self.friction_scale * ph.rn * self.temp * self.f_c
         self.visc_c = self.visc_k * self.mu_v / self.hbar
