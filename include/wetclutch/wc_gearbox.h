@@ -91,7 +91,13 @@ typedef enum {
     WC_GEARBOX_SHIFT_SWAP = 3,            /* more than one element would open and close: refused (a swap ties up
                                            * or flares; the integrator shifts through an intermediate gear) */
     WC_GEARBOX_SHIFT_DIRECTION = 4,       /* to or from reverse: not a shift under way (the vehicle stands) */
-    WC_GEARBOX_SHIFT_NOT_IN_TABLE = 5     /* a single-element change the table does not carry */
+    WC_GEARBOX_SHIFT_NOT_IN_TABLE = 5,    /* a single-element change the table does not carry */
+    WC_GEARBOX_SHIFT_NOT_CURRENT = 6,     /* the request's current gear is not the one the elements hold
+                                           * (wc_transmission: the integrator and the TCU disagree) */
+    WC_GEARBOX_SHIFT_BUSY = 7,            /* a shift runs, or the loop is in its safe state: no new one */
+    WC_GEARBOX_SHIFT_NO_MODEL = 8         /* an element's equivalent clutch for this shift is outside the
+                                           * calibration's limits (wc_transmission_equivalent: R_o |a| > 1 m,
+                                           * or A_f > pi (R_o |a|)^2 for |a| < 1: the 8HP's 1<->7 skips) */
 } wc_gearbox_shift_result_t;
 
 /* The shift from current_gear to target_gear: WC_GEARBOX_SHIFT_OK and *shift

@@ -59,7 +59,8 @@ typedef enum {
     WC_SHIFT_ABORT_LOCKUP_FAILED = 2,    /* the clutch was not locked at the end of the hand-over */
     WC_SHIFT_ABORT_INPUT_LOST = 3,       /* the frame loop went to its safe state during the shift */
     WC_SHIFT_ABORT_CANCELLED = 4,        /* the command was withdrawn before the shift completed */
-    WC_SHIFT_ABORT_INVALID_COMMAND = 5,  /* target gear not 2, target time or turbine torque out of range */
+    WC_SHIFT_ABORT_INVALID_COMMAND = 5,  /* target gear not WC_SHIFT_TARGET_GEAR, target time or turbine torque
+                                          * out of range */
     WC_SHIFT_ABORT_NO_SLIP = 6           /* slip at inertia start not above min_start_slip_rad_s */
 } wc_shift_abort_t;
 
@@ -189,7 +190,8 @@ typedef enum {
     WC_SHIFT_CAL_ADAPT_MIN_SLIP_DROP,
     WC_SHIFT_CAL_ADAPT_MIN_CONDITIONING,
     WC_SHIFT_CAL_COORDINATOR,
-    WC_SHIFT_CAL_OFFGOING_RATIO,       /* also: coordinator 1 and not above output_ratio */
+    WC_SHIFT_CAL_OFFGOING_RATIO,       /* also: coordinator 1 and not WC_SHIFT_GEAR_STEP_MIN x output_ratio
+                                        * away from it */
     WC_SHIFT_CAL_FILL_PULSE_CURRENT,
     WC_SHIFT_CAL_FILL_PULSE_TIME,      /* also: above prepare_time_s */
     WC_SHIFT_CAL_OFFGOING_HOLDING_FACTOR,
@@ -224,6 +226,13 @@ typedef enum {
 #define WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm 1000.0f
 /* The kiss offset's band: at most 1 MPa (a kiss pressure is about 0.1 MPa). */
 #define WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa 1e6f
+/* The shift controller knows one shift, its calibration's reduced model
+ * (DESIGN 10, 15): the command's target gear is this one (the 1->2 bench's
+ * 2nd gear; wc_transmission maps every shift of a gearbox onto it). */
+#define WC_SHIFT_TARGET_GEAR 2u
+/* The off-going and the target ratio differ by at least this fraction of the
+ * target's (the gear step 1 - b / b1 divides; real steps are 10 % and more). */
+#define WC_SHIFT_GEAR_STEP_MIN 0.01f
 /* The hand-over waits this many lockup_ramp_time_s for the lock-up (its dwell, a slow cold film). */
 #define WC_SHIFT_LOCKUP_WAIT 4u
 /* The whole shift (DESIGN 14): into the inertia phase the off-going clutch
@@ -261,7 +270,7 @@ typedef struct {
 /* The shift command (DBC ShiftCommand), as the frame loop received it. */
 typedef struct {
     bool request;                  /* 1: shift on; a rising edge while IDLE starts it; 0: end/cancel */
-    uint32_t target_gear;          /* only 2 (the 1->2 upshift) is supported */
+    uint32_t target_gear;          /* WC_SHIFT_TARGET_GEAR: the one shift of the calibration's reduced model */
     float turbine_torque_Nm;       /* the engine controller's turbine torque estimate T_t */
     float target_inertia_time_s;   /* in [inertia_time_min_s, inertia_time_max_s] */
 } wc_shift_command_t;
@@ -355,5 +364,51 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
 bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
                    bool safe, wc_clutch_t *clutch, wc_adapt_t *adapt, wc_step_input_t *in, wc_step_output_t *out,
                    wc_shift_report_t *report, wc_shift_offgoing_t *offgoing);
+
+/* The inertia-phase-first shift (DESIGN 15: the power-on downshift, the
+ * kickdown; mirrored by wc_transmission, the power-off upshift): the
+ * off-going clutch (offgoing, required) lets the turbine run to the target
+ * gear's speed on the reference slip while the on-coming clutch (clutch)
+ * waits filled at its kiss point; at synchronism the torque phase hands the
+ * torque over. In the controller's frame the turbine torque is >= 0, the
+ * on-coming slip starts negative (the turbine below the target gear's speed)
+ * and the off-going slip turns positive. Phases:
+ *   PREPARE   prepare_time_s: the on-coming clutch filled (the fill pulse,
+ *             then the kiss point); the off-going request ramps from
+ *             offgoing_holding_factor x T_t to (1 + offgoing_margin_factor) x T_t,
+ *             just above what it carries.
+ *   INERTIA   the reference slip from the on-coming slip at the phase start
+ *             (below -min_start_slip_rad_s, else AbortReason 6) to 0 as in
+ *             the torque-first shift, in the commanded time or, when T_t
+ *             cannot move the turbine that fast, the time it can (1.25 x
+ *             1.5 |slip_0| I_t / T_t, at most inertia_time_max_s: only the
+ *             turbine torque drives this phase); the off-going request = feed-forward
+ *             (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out) + PI(slip -
+ *             reference); the on-coming clutch at its kiss point. Ends as
+ *             the torque-first inertia phase (the lock band's dwell, or the
+ *             reference ended within min_start_slip_rad_s); flare: the slip
+ *             above +flare_slip_rad_s (past synchronism).
+ *   TORQUE    torque_phase_time_s at synchronism: the on-coming request
+ *             rises on a smoothstep to holding_torque_factor x its carried
+ *             torque (+ flare_kp x the slip past synchronism + flare_ki x its
+ *             integral: the turbine running past is taken in closed loop)
+ *             while the off-going request falls from its last value to
+ *             0 on the same smoothstep; LOCKED once the on-coming clutch is
+ *             locked and the ramp done; not locked after WC_SHIFT_LOCKUP_WAIT
+ *             ramp times: AbortReason 2.
+ *   LOCKED / ABORTED as the torque-first shift. A lost input (safe): before
+ *             the torque phase handed back (the off-going clutch at its
+ *             maximum current, AbortReason 3, fallback HANDBACK); from the
+ *             torque phase on finished on the model (the ramps on time, never
+ *             reported locked without the slip), released after
+ *             fallback_time_s.
+ * No engine request (engine_active false) and no adaptation in this type
+ * yet; the report's friction energy is both clutches' (the off-going one
+ * does the inertia phase's work), its jerk that of the output torque
+ * T_c + (b1 / b) T_1, tie_up never set (the plant measures it). */
+bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
+                                 const wc_shift_command_t *command, bool safe, wc_clutch_t *clutch,
+                                 wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
+                                 wc_shift_offgoing_t *offgoing);
 
 #endif /* WC_SHIFT_H */

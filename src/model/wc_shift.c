@@ -6,9 +6,7 @@
 
 #include "wc_field_ranges.h"
 #include "wc_internal.h"
-
-/* A value in [lo, hi] (false for NaN). */
-static bool in_closed(float value, float lo, float hi) { return (value >= lo) && (value <= hi); }
+#include "wc_shift_internal.h"
 
 /* The range of each field, in declaration order, which is the order of the
  * codes: member, code, flags (wc_field_ranges.h), low, high. A time "0 or
@@ -99,8 +97,11 @@ wc_shift_cal_error_t wc_shift_calibration_check(const wc_shift_calibration_t *ca
     if (cal == NULL) { return WC_SHIFT_CAL_NULL; }
     const uint32_t i = wc_field_first_invalid(cal, &field_rules);
     if (i < field_rules.count) { return (wc_shift_cal_error_t)((uint32_t)WC_SHIFT_CAL_TURBINE_INERTIA + i); }
-    /* DESIGN 14: the off-going gear is the lower one (its slip turns negative in the inertia phase) */
-    if ((cal->coordinator == 1u) && !(cal->offgoing_ratio > cal->output_ratio)) { return WC_SHIFT_CAL_OFFGOING_RATIO; }
+    /* DESIGN 14, 15: the two gears differ (the gear step 1 - b / b1 divides; a downshift's b1 is below b) */
+    if ((cal->coordinator == 1u) && (!(cal->offgoing_ratio > 0.0f) || /* off (0) is no ratio for the coordinator */
+                                     !(fabsf(cal->offgoing_ratio - cal->output_ratio) >= WC_SHIFT_GEAR_STEP_MIN * cal->output_ratio))) {
+        return WC_SHIFT_CAL_OFFGOING_RATIO;
+    }
     if (cal->fill_pulse_time_s > cal->prepare_time_s) { return WC_SHIFT_CAL_FILL_PULSE_TIME; }
     return WC_SHIFT_CAL_OK;
 }
@@ -112,23 +113,9 @@ void wc_shift_init(wc_shift_t *shift)
     (void)memset(shift, 0, sizeof *shift);  /* all zero: IDLE, no report, no fallback (IEEE 754 zeros) */
 }
 
-/* Inline in the step at -O2 (no call, no rate through memory); the public function is the same code. */
-WC_INLINE_HOT float reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
-{
-    /* DESIGN 10: smoothstep from the start slip to 0; zero slope at both ends,
-     * so the feed-forward (and the clutch torque) neither steps at the phase
-     * start nor at lock-up. */
-    float x = (target_time_s > 0.0f) ? (elapsed_s / target_time_s) : 1.0f;
-    x = (x > 0.0f) ? ((x < 1.0f) ? x : 1.0f) : 0.0f;  /* also NaN -> 0 */
-    if (rate_rad_s2 != NULL) {
-        *rate_rad_s2 = (target_time_s > 0.0f) ? (-6.0f * start_slip_rad_s * x * (1.0f - x) / target_time_s) : 0.0f;
-    }
-    return start_slip_rad_s * (1.0f - x * x * (3.0f - 2.0f * x));
-}
-
 float wc_shift_reference_slip(float start_slip_rad_s, float target_time_s, float elapsed_s, float *rate_rad_s2)
 {
-    return reference_slip(start_slip_rad_s, target_time_s, elapsed_s, rate_rad_s2);
+    return wc_shift_reference_at(start_slip_rad_s, target_time_s, elapsed_s, rate_rad_s2);
 }
 
 /* The driveline model's terms of the feed-forward (DESIGN 10), once per
@@ -150,45 +137,15 @@ static wc_driveline_t driveline(const wc_shift_calibration_t *cal, float turbine
     return d;
 }
 
-static float clamp_torque_Nm(float torque_Nm)
-{
-    return (torque_Nm > 0.0f) ? ((torque_Nm < WC_TORQUE_MAX_Nm) ? torque_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
-}
-
 static float feedforward_Nm(const wc_driveline_t *d, float reference_rate_rad_s2)
 {
-    return clamp_torque_Nm((d->drive_rad_s2 - reference_rate_rad_s2) / d->inverse_inertia);
+    return wc_shift_clamp_torque_Nm((d->drive_rad_s2 - reference_rate_rad_s2) / d->inverse_inertia);
 }
 
 float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float reference_rate_rad_s2)
 {
     const wc_driveline_t d = driveline(cal, turbine_torque_Nm);
     return feedforward_Nm(&d, reference_rate_rad_s2);
-}
-
-static uint32_t periods_of(float time_s, float dt_s)
-{
-    const float n = time_s / dt_s + 0.5f;  /* both checked: time <= 10 s, dt >= 1e-4 s */
-    return (uint32_t)n;
-}
-
-static void enter(wc_shift_t *shift, wc_shift_phase_t phase)
-{
-    shift->phase = (uint32_t)phase;
-    shift->phase_periods = 0u;
-}
-
-static void abort_shift(wc_shift_t *shift, wc_shift_abort_t reason)
-{
-    enter(shift, WC_SHIFT_ABORTED);
-    shift->report.abort_reason = (uint32_t)reason;
-}
-
-static bool command_valid(const wc_shift_calibration_t *cal, const wc_shift_command_t *command)
-{
-    return (command->target_gear == 2u) &&
-           in_closed(command->target_inertia_time_s, cal->inertia_time_min_s, cal->inertia_time_max_s) &&
-           in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm);
 }
 
 /* The whole shift (DESIGN 14) runs when the calibration asks for it and the
@@ -216,16 +173,7 @@ static void start(wc_shift_t *shift, const wc_shift_command_t *command, float sl
     shift->target_time_s = command->target_inertia_time_s;
     shift->start_slip_rad_s = slip_rad_s;
     shift->report.peak_theta_degC = WC_THETA_MIN_degC;
-    enter(shift, WC_SHIFT_PREPARE);
-}
-
-/* The inertia phase's end: the reference has run out (fallback: on the
- * model, the slip is not known). */
-static void enter_lockup(wc_shift_t *shift, float elapsed_s)
-{
-    shift->report.inertia_time_s = elapsed_s;
-    shift->phase_start_request_Nm = shift->request_Nm;
-    enter(shift, WC_SHIFT_LOCKUP);
+    wc_shift_enter(shift, WC_SHIFT_PREPARE);
 }
 
 /* The turbine torque that goes through the clutches in 1st gear (DESIGN 14):
@@ -235,8 +183,9 @@ static void enter_lockup(wc_shift_t *shift, float elapsed_s)
  * off-going one: tie-up), and the off-going one carries what is left of it. */
 static float through_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *cal)
 {
-    const float gear_step = 1.0f - cal->output_ratio / cal->offgoing_ratio;  /* > 0: checked with the coordinator */
-    return clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
+    /* |.| >= 1 % (checked with the coordinator); < 0 in a coast downshift's mirror (wc_transmission.h) */
+    const float gear_step = 1.0f - cal->output_ratio / cal->offgoing_ratio;
+    return wc_shift_clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
 }
 
 /* The flare (DESIGN 14): the off-going clutch slipping forward, the turbine above the 1st-gear speed. */
@@ -265,11 +214,11 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
 {
     const float share_Nm = shift->turbine_torque_Nm / cal->turbine_ratio;  /* T_t / a */
     if (shift->phase == (uint32_t)WC_SHIFT_PREPARE) {
-        if (shift->phase_periods < periods_of(cal->prepare_time_s, dt_s)) { return 0.0f; }
-        enter(shift, WC_SHIFT_TORQUE);
+        if (shift->phase_periods < wc_shift_periods_of(cal->prepare_time_s, dt_s)) { return 0.0f; }
+        wc_shift_enter(shift, WC_SHIFT_TORQUE);
     }
     if (shift->phase == (uint32_t)WC_SHIFT_TORQUE) {
-        const uint32_t n = periods_of(cal->torque_phase_time_s, dt_s);
+        const uint32_t n = wc_shift_periods_of(cal->torque_phase_time_s, dt_s);
         /* DESIGN 14: the off-going clutch slips backwards, so the on-coming clutch holds the turbine (the
          * speeds show the tie-up): the torque phase is over, the off-going clutch is released */
         const bool handed_over = coord && (shift->offgoing_slip_rad_s < -cal->handover_slip_rad_s);
@@ -283,19 +232,19 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         }
         /* inertia phase: the reference starts at the measured slip; bumpless:
          * the integral takes what the feed-forward does not give of the last request */
-        enter(shift, WC_SHIFT_INERTIA);
+        wc_shift_enter(shift, WC_SHIFT_INERTIA);
         shift->second_gear = coord;
         shift->start_slip_rad_s = slip_rad_s;
         shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * carried_Nm;
         if (!(slip_rad_s > cal->min_start_slip_rad_s)) {
-            abort_shift(shift, WC_SHIFT_ABORT_NO_SLIP);
+            wc_shift_abort(shift, WC_SHIFT_ABORT_NO_SLIP);
             return 0.0f;
         }
     }
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s;
-        const float reference = reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float reference = wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
         const float ff_Nm = cal->feedforward_gain * feedforward_Nm(d, rate_rad_s2);
         if (shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE) {
             /* DESIGN 14: the slip is not known: the feed-forward on the reference, the integral frozen */
@@ -321,7 +270,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     const float hold_share_Nm = (coord && (shift->driver_torque_Nm > shift->turbine_torque_Nm))
                                     ? (shift->driver_torque_Nm / cal->turbine_ratio) : share_Nm;
     if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
-        const uint32_t n = periods_of(cal->lockup_ramp_time_s, dt_s);
+        const uint32_t n = wc_shift_periods_of(cal->lockup_ramp_time_s, dt_s);
         const float hold_Nm = cal->holding_torque_factor * hold_share_Nm;
         const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
         return shift->phase_start_request_Nm + (hold_Nm - shift->phase_start_request_Nm) * ((x < 1.0f) ? x : 1.0f);
@@ -330,32 +279,26 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
     return cal->holding_torque_factor * hold_share_Nm;
 }
 
-/* The fallback in the state and in the running report. */
-static void set_fallback(wc_shift_t *shift, wc_shift_fallback_t fallback)
-{
-    shift->fallback = (uint32_t)fallback;
-    shift->report.fallback = (uint32_t)fallback;
-}
-
 /* A lost input (the loop's safe state) with the coordinator (DESIGN 14): the
  * fallback of the phase, the engine request withdrawn (engine_request). */
 static void fall_back(wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
 {
     if (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) {
-        if ((shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_TORQUE)) {
-            /* the off-going clutch still has the gear: hand it back */
-            set_fallback(shift, WC_SHIFT_FALLBACK_HANDBACK);
-            abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
+        if (!shift->second_gear) {
+            /* the off-going clutch still has the gear (the torque-first shift's prepare and torque phases, the
+             * inertia-first one's prepare and inertia phases): hand it back */
+            wc_shift_set_fallback(shift, WC_SHIFT_FALLBACK_HANDBACK);
+            wc_shift_abort(shift, WC_SHIFT_ABORT_INPUT_LOST);
             return;
         }
-        set_fallback(shift, WC_SHIFT_FALLBACK_FINISH);  /* inertia phase or later: finish on the model */
+        wc_shift_set_fallback(shift, WC_SHIFT_FALLBACK_FINISH);  /* inertia phase or later: finish on the model */
     }
     if ((float)shift->fallback_periods * dt_s > cal->fallback_time_s) {
-        set_fallback(shift, WC_SHIFT_FALLBACK_RELEASED);  /* neither possible: released */
+        wc_shift_set_fallback(shift, WC_SHIFT_FALLBACK_RELEASED);  /* neither possible: released */
         if (wc_shift_phase_running(shift->phase)) {
-            abort_shift(shift, WC_SHIFT_ABORT_INPUT_LOST);
+            wc_shift_abort(shift, WC_SHIFT_ABORT_INPUT_LOST);
         } else {
-            enter(shift, WC_SHIFT_IDLE);  /* LOCKED: released; the off-going clutch stays open (second gear) */
+            wc_shift_enter(shift, WC_SHIFT_IDLE);  /* LOCKED: released; the off-going clutch stays open (second gear) */
         }
     }
 }
@@ -375,13 +318,13 @@ static void resume(wc_shift_t *shift, const wc_shift_calibration_t *cal, float s
     shift->fallback_periods = 0u;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         const wc_driveline_t d = driveline(cal, shift->turbine_torque_Nm);
-        enter(shift, WC_SHIFT_INERTIA);
+        wc_shift_enter(shift, WC_SHIFT_INERTIA);
         shift->start_slip_rad_s = slip_rad_s;
         shift->band_periods = 0u;
         shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * feedforward_Nm(&d, 0.0f);
         wc_adapt_begin(adapt);
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
-        enter(shift, WC_SHIFT_LOCKUP);
+        wc_shift_enter(shift, WC_SHIFT_LOCKUP);
         shift->phase_start_request_Nm = shift->request_Nm;
         wc_adapt_begin(adapt);
     } else {
@@ -389,14 +332,10 @@ static void resume(wc_shift_t *shift, const wc_shift_calibration_t *cal, float s
     }
 }
 
-/* Before the clutch step: the transitions on the command and the loop's
- * state, then the clutch input (in place: mode, request, carried torque, lag
- * compensation, temperature source). saturated: the last step's output was. */
-static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                         bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
-                         wc_adapt_t *adapt, wc_step_input_t *in, const wc_shift_offgoing_t *offgoing)
+void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                                      bool safe, bool coord, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
+                                      wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing)
 {
-    const bool coord = coordinated(cal, offgoing);
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
 
@@ -405,13 +344,13 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         fall_back(shift, cal, dt_s);  /* DESIGN 14: not released at once */
     } else if (safe || !command->request) {
         if (wc_shift_phase_running(shift->phase)) {
-            abort_shift(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
+            wc_shift_abort(shift, safe ? WC_SHIFT_ABORT_INPUT_LOST : WC_SHIFT_ABORT_CANCELLED);
         } else if (!command->request || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
-            enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
+            wc_shift_enter(shift, WC_SHIFT_IDLE);  /* the safe state releases a completed shift's clutch too */
             if (!safe) { shift->second_gear = false; }  /* withdrawn: the VCU takes 1st gear back (DESIGN 14) */
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
-        if (command_valid(cal, command)) {
+        if (wc_shift_command_valid(cal, command)) {
             const wc_lag_compensation_t lag = wc_lag_compensation(clutch, cal->lag_compensation_time_s);
             const wc_lag_compensation_t off = coord ? wc_lag_compensation(offgoing->clutch,
                                                                           cal->offgoing_lag_compensation_time_s)
@@ -420,7 +359,7 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         } else {  /* nothing of the command is kept (it may hold NaN) */
             wc_shift_init(shift);
             shift->last_request = true;
-            abort_shift(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
+            wc_shift_abort(shift, WC_SHIFT_ABORT_INVALID_COMMAND);
         }
     }
     if (!safe && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
@@ -432,10 +371,21 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         /* DESIGN 14: the fallback withdrew the engine request: the driver's torque T_t0, not the last
          * estimate, which may still hold the reduction (issue 29 item 7) */
         shift->turbine_torque_Nm = shift->driver_torque_Nm;
-    } else if (follow && in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+    } else if (follow && wc_shift_in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
     if (resumed) { resume(shift, cal, slip_rad_s, adapt); }
+}
+
+/* Before the clutch step: the transitions on the command and the loop's
+ * state, then the clutch input (in place: mode, request, carried torque, lag
+ * compensation, temperature source). saturated: the last step's output was. */
+static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                         bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
+                         wc_adapt_t *adapt, wc_step_input_t *in, const wc_shift_offgoing_t *offgoing)
+{
+    const bool coord = coordinated(cal, offgoing);
+    wc_shift_transitions(shift, cal, command, safe, coord, slip_rad_s, dt_s, clutch, adapt, offgoing);
 
     in->mode = WC_MODE_OPEN;
     in->torque_request_Nm = 0.0f;
@@ -456,7 +406,7 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         /* once synchronous the clutch carries what the driveline model says
          * (the feed-forward at a zero slip rate), not the request */
         const float carried_Nm = feedforward_Nm(&d, 0.0f);
-        const float request_Nm = clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm,
+        const float request_Nm = wc_shift_clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm,
                                                                   coord));
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
             in->mode = WC_MODE_TORQUE;
@@ -483,7 +433,9 @@ static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibra
     bool active = (cal->engine_intervention == 1u) && (shift->report.fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
     const float t0_Nm = shift->driver_torque_Nm;
     const float hole_Nm = cal->engine_fill_fraction * (cal->offgoing_ratio - cal->output_ratio) / cal->output_ratio * t0_Nm;
-    const float increase_Nm = (hole_Nm < cal->engine_increase_max_Nm) ? hole_Nm : cal->engine_increase_max_Nm;
+    /* a downshift's b1 < b: the torque phase raises the output torque; a negative "increase" lowers it */
+    const float max_Nm = cal->engine_increase_max_Nm;
+    const float increase_Nm = (hole_Nm < max_Nm) ? ((hole_Nm > -max_Nm) ? hole_Nm : -max_Nm) : max_Nm;
     const uint32_t phase = shift->phase;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
         delta_Nm = increase_Nm * torque_phase_share(shift, cal, dt_s, cal->engine_lead_time_s);
@@ -491,7 +443,7 @@ static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibra
     } else if (phase == (uint32_t)WC_SHIFT_INERTIA) {
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s + cal->engine_lead_time_s;
-        const float reference = reference_slip(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float reference = wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
         const float s = (shift->start_slip_rad_s > 0.0f) ? (1.0f - reference / shift->start_slip_rad_s) : 1.0f;
         const float inertia_Nm = cal->engine_reduction_fraction * cal->turbine_inertia_kg_m2 * fabsf(rate_rad_s2) /
                                  cal->turbine_ratio;
@@ -538,8 +490,8 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
             in->mode = WC_MODE_LOCKED;  /* hold the gear without inputs (hand-back) */
         } else if ((phase == (uint32_t)WC_SHIFT_IDLE) || (phase == (uint32_t)WC_SHIFT_PREPARE)) {
             in->mode = WC_MODE_TORQUE;
-            in->torque_request_Nm = clamp_torque_Nm(cal->offgoing_holding_factor * t_t_Nm);
-            in->carried_torque_Nm = clamp_torque_Nm(t_t_Nm);
+            in->torque_request_Nm = wc_shift_clamp_torque_Nm(cal->offgoing_holding_factor * t_t_Nm);
+            in->carried_torque_Nm = wc_shift_clamp_torque_Nm(t_t_Nm);
         } else if (phase == (uint32_t)WC_SHIFT_TORQUE) {
             handing_over = true;
         } else {
@@ -556,7 +508,7 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
         /* second gear: open */
     }
     if (handing_over) {
-        const float carried_Nm = clamp_torque_Nm(through_Nm(shift, cal) - cal->turbine_ratio * oncoming_torque_Nm);
+        const float carried_Nm = wc_shift_clamp_torque_Nm(through_Nm(shift, cal) - cal->turbine_ratio * oncoming_torque_Nm);
         const float flare_rad_s = flare_slip_rad_s(shift);
         const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * flare_rad_s * dt_s;
         shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
@@ -565,10 +517,69 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
         /* the margin tapers with the on-coming clutch's ramp: at the hand-over the off-going clutch
          * holds nothing the on-coming one could fight (tie-up) */
         const float taper = (phase == (uint32_t)WC_SHIFT_TORQUE) ? (1.0f - torque_phase_share(shift, cal, dt_s, 0.0f)) : 0.0f;
-        in->torque_request_Nm = clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
+        in->torque_request_Nm = wc_shift_clamp_torque_Nm(carried_Nm + cal->offgoing_margin_factor * shift->driver_torque_Nm * taper +
                                                 cal->flare_kp_Nm_per_rad_s * flare_rad_s + shift->flare_integral_Nm);
         in->carried_torque_Nm = carried_Nm;
     }
+}
+
+/* The inertia phase's end, after the step (both controllers, DESIGN 10):
+ * true when it is over (the slip in the lock band for the dwell, the model
+ * locked, or the reference ended near synchronism), report.inertia_time_s
+ * set; an overrun aborts (AbortReason 1). locked: the controlled clutch's
+ * model locked this step. */
+bool wc_shift_inertia_over(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool locked,
+                           float slip_rad_s, float dt_s)
+{
+    const bool fallback = shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE;
+    const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
+    const wc_calibration_t *clutch_cal = clutch->model.cal;
+    const bool in_band = (clutch_cal != NULL) && (fabsf(slip_rad_s) < clutch_cal->lock_slip_rad_s);
+    shift->band_periods = in_band ? (shift->band_periods + 1u) : 0u;  /* bounded: the phase times out */
+    const bool synchronous = (clutch_cal != NULL) && (shift->band_periods >= clutch_cal->lock_dwell_periods);
+    /* the reference has ended near synchronism: the last slip (the clutch's
+     * torque falls with it, and its static capacity is below the kinetic
+     * torque there) is pulled in by the hand-over's force, not left to the
+     * integral; far from it the inertia phase goes on (and may time out) */
+    const bool reference_ended = (elapsed_s >= shift->target_time_s) &&
+                                 (fallback || (fabsf(slip_rad_s) <= cal->min_start_slip_rad_s));
+    if ((!fallback && (locked || synchronous)) || reference_ended) {
+        shift->report.inertia_time_s = elapsed_s;
+        return true;
+    }
+    if (elapsed_s > shift->target_time_s * cal->inertia_timeout_factor) {
+        shift->report.inertia_time_s = elapsed_s;
+        wc_shift_abort(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
+    }
+    return false;
+}
+
+/* The quality vector's period (both controllers, DESIGN 10): from the
+ * command to the shift's end the friction heat heat_W (eq. 1's input), the
+ * peak temperature, the jerk of output_torque_Nm (not on the first sample);
+ * the phase's period count (a phase entered after the step counts from the
+ * next); true when the shift ended this step (LOCKED or ABORTED entered),
+ * then the slip RMSE is final. */
+bool wc_shift_account(wc_shift_t *shift, const wc_shift_calibration_t *cal, uint32_t phase_before, uint32_t phase_stepped,
+                      float heat_W, float theta_degC, float output_torque_Nm, float dt_s)
+{
+    if (wc_shift_phase_running(phase_before) || wc_shift_phase_running(shift->phase)) {
+        wc_shift_report_t *q = &shift->report;
+        q->friction_energy_J += heat_W * dt_s;
+        if (theta_degC > q->peak_theta_degC) { q->peak_theta_degC = theta_degC; }
+        const float jerk = wc_shift_jerk(cal, &shift->filtered_torque_Nm, output_torque_Nm, dt_s);
+        if (wc_shift_phase_running(phase_before) && (jerk > q->peak_jerk_m_s3)) { q->peak_jerk_m_s3 = jerk; }
+    }
+    if (shift->phase == phase_stepped) {
+        shift->phase_periods = (shift->phase_periods < UINT32_MAX) ? (shift->phase_periods + 1u) : UINT32_MAX;
+    }
+    const bool ended = (phase_before != shift->phase) &&
+                       ((shift->phase == (uint32_t)WC_SHIFT_LOCKED) || (shift->phase == (uint32_t)WC_SHIFT_ABORTED));
+    if (ended) {
+        shift->report.slip_rmse_rad_s = (shift->inertia_periods > 0u)
+                                            ? sqrtf(shift->error_sq_sum / (float)shift->inertia_periods) : 0.0f;
+    }
+    return ended;
 }
 
 /* After the clutch step: the lock-up decides the inertia phase's end, the
@@ -586,58 +597,26 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
         wc_adapt_sample(adapt, cal, (float)shift->phase_periods * dt_s, slip_rad_s, d.drive_rad_s2,
                         d.inverse_inertia, clutch, out);
     }
-    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
-        const float elapsed_s = (float)(shift->phase_periods + 1u) * dt_s;
-        const wc_calibration_t *clutch_cal = clutch->model.cal;
-        const bool in_band = (clutch_cal != NULL) && (fabsf(slip_rad_s) < clutch_cal->lock_slip_rad_s);
-        shift->band_periods = in_band ? (shift->band_periods + 1u) : 0u;  /* bounded: the phase times out */
-        const bool synchronous = (clutch_cal != NULL) && (shift->band_periods >= clutch_cal->lock_dwell_periods);
-        /* the reference has ended near synchronism: the last slip (the clutch's
-         * torque falls with it, and its static capacity is below the kinetic
-         * torque there) is pulled in by the hand-over's force, not left to the
-         * integral; far from it the inertia phase goes on (and may time out) */
-        const bool reference_ended = (elapsed_s >= shift->target_time_s) &&
-                                     (fallback || (fabsf(slip_rad_s) <= cal->min_start_slip_rad_s));
-        if ((!fallback && (locked || synchronous)) || reference_ended) {
-            enter_lockup(shift, elapsed_s);
-        } else if (elapsed_s > shift->target_time_s * cal->inertia_timeout_factor) {
-            shift->report.inertia_time_s = elapsed_s;
-            abort_shift(shift, WC_SHIFT_ABORT_INERTIA_TIMEOUT);
-        }
+    if ((shift->phase == (uint32_t)WC_SHIFT_INERTIA) && wc_shift_inertia_over(shift, cal, clutch, locked, slip_rad_s, dt_s)) {
+        shift->phase_start_request_Nm = shift->request_Nm;
+        wc_shift_enter(shift, WC_SHIFT_LOCKUP);
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
         /* locked once the ramp is done (the lock-up's dwell and the film may end
          * after it): within WC_SHIFT_LOCKUP_WAIT ramp times */
-        const uint32_t ramp = periods_of(cal->lockup_ramp_time_s, dt_s);
+        const uint32_t ramp = wc_shift_periods_of(cal->lockup_ramp_time_s, dt_s);
         if (fallback) {
             /* the slip is not known: the hand-over holds, never reported locked (issue 29 item 7); the
              * input back restarts it (resume), else fall_back releases it after fallback_time_s */
         } else if (locked && (shift->phase_periods + 1u >= ramp)) {
-            enter(shift, WC_SHIFT_LOCKED);
+            wc_shift_enter(shift, WC_SHIFT_LOCKED);
         } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
-            abort_shift(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
+            wc_shift_abort(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
         }
     }
 
-    /* Quality vector over the shift (command to its end). */
-    if (wc_shift_phase_running(phase_before) || wc_shift_phase_running(shift->phase)) {
-        wc_shift_report_t *q = &shift->report;
-        q->friction_energy_J += fabsf(out->model.torque_Nm * slip_rad_s) * dt_s;  /* eq. 1's heat input */
-        if (clutch->theta_degC > q->peak_theta_degC) { q->peak_theta_degC = clutch->theta_degC; }
-        const float alpha = dt_s / (cal->jerk_filter_time_s + dt_s);  /* first-order filter, exact for tau = 0 */
-        const float filtered = shift->filtered_torque_Nm + (out->model.torque_Nm - shift->filtered_torque_Nm) * alpha;
-        const float jerk = fabsf(cal->jerk_per_torque_rate * (filtered - shift->filtered_torque_Nm) / dt_s);
-        if (wc_shift_phase_running(phase_before) && (jerk > q->peak_jerk_m_s3)) { q->peak_jerk_m_s3 = jerk; }  /* not the first sample */
-        shift->filtered_torque_Nm = filtered;
-    }
-    if (shift->phase == phase_stepped) {  /* a phase entered after the step starts counting at the next */
-        shift->phase_periods = (shift->phase_periods < UINT32_MAX) ? (shift->phase_periods + 1u) : UINT32_MAX;
-    }
-
-    const bool ended = (phase_before != shift->phase) &&
-                       ((shift->phase == (uint32_t)WC_SHIFT_LOCKED) || (shift->phase == (uint32_t)WC_SHIFT_ABORTED));
+    const bool ended = wc_shift_account(shift, cal, phase_before, phase_stepped, fabsf(out->model.torque_Nm * slip_rad_s),
+                                        clutch->theta_degC, out->model.torque_Nm, dt_s);
     if (ended) {
-        shift->report.slip_rmse_rad_s = (shift->inertia_periods > 0u)
-                                            ? sqrtf(shift->error_sq_sum / (float)shift->inertia_periods) : 0.0f;
         /* DESIGN 12: learn from the shift (only a valid one changes anything) */
         shift->report.adaptation = wc_adapt_finish(adapt, cal, shift->report.abort_reason, clutch);
         *report = shift->report;
@@ -649,12 +628,12 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
  * the VFS gets fill_pulse_current_mA to stroke the piston fast; the model
  * steps at the kiss point meanwhile (request 0), which is what the chamber
  * holds while the piston strokes against its spring. */
-static WC_NOINLINE void fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
-                       float dt_s, wc_step_output_t *out)
+WC_NOINLINE void wc_shift_fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
+                                     float dt_s, wc_step_output_t *out)
 {
     const wc_calibration_t *c = clutch->model.cal;
     if ((c == NULL) || (shift->phase != (uint32_t)WC_SHIFT_PREPARE) ||
-        (shift->phase_periods >= periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
+        (shift->phase_periods >= wc_shift_periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
         return;
     }
     const float i = cal->fill_pulse_current_mA;
@@ -698,7 +677,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
     (void)wc_clutch_step(clutch, in, out);
     if (coord) {  /* DESIGN 14: the fill pulse, the off-going clutch (one clutch step deep), the engine */
-        fill_pulse(shift, cal, clutch, dt_s, out);
+        wc_shift_fill_pulse(shift, cal, clutch, dt_s, out);
         offgoing_input(shift, cal, safe, out->model.torque_Nm, dt_s, offgoing);
         (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
         engine_request(shift, cal, dt_s, offgoing);

@@ -201,9 +201,15 @@ static void test_calibration_whole_shift_rules(void **state)
     cal.coordinator = 1u;
     cal.offgoing_ratio = 0.0f;  /* off (0) is not a ratio for the coordinator */
     assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
-    cal.offgoing_ratio = cal.output_ratio;  /* the off-going gear must be the lower one */
+    cal.offgoing_ratio = cal.output_ratio;  /* the two gears must differ (the gear step divides) */
     assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
-    cal.offgoing_ratio = cal.output_ratio * 1.5f;
+    cal.offgoing_ratio = cal.output_ratio * 1.009f;  /* a step below WC_SHIFT_GEAR_STEP_MIN (1 %) */
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
+    cal.offgoing_ratio = cal.output_ratio * 0.991f;
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);
+    cal.offgoing_ratio = cal.output_ratio * 1.5f;  /* an upshift's reduced model */
+    assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
+    cal.offgoing_ratio = cal.output_ratio / 1.5f;  /* a downshift's (DESIGN 15) */
     assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OK);
     cal.offgoing_ratio = NAN;
     assert_int_equal(wc_shift_calibration_check(&cal), WC_SHIFT_CAL_OFFGOING_RATIO);

@@ -217,7 +217,7 @@ _SHIFT = {
     "adapt_min_slip_drop": (0.0, 1.0, "", "excitation: the slip falls by this fraction of its window start"),
     "adapt_min_conditioning": (0.0, 1.0, "", "the kiss point's least squares: D / (S11 S22) at least this"),
     "coordinator": (0, 1, "", "1: the whole shift (off-going clutch, fill, engine; DESIGN 14)"),
-    "offgoing_ratio": (0.0, 20.0, "0 or >= 0.05; with the coordinator > output_ratio", "b1 = i1: the off-going clutch's ratio"),
+    "offgoing_ratio": (0.0, 20.0, "0 or >= 0.05; with the coordinator at least 1 % away from output_ratio (an upshift above, a downshift below)", "b1 = i1: the off-going clutch's ratio"),
     "fill_pulse_current_mA": (0.0, shift_rules.CURRENT_MAX_MA, "", "fill pulse current"),
     "fill_pulse_time_s": (0.0, _T, "<= prepare_time_s", "fill pulse time"),
     "offgoing_holding_factor": (0.0, 5.0, "", "off-going capacity request before the torque phase / T_t"),

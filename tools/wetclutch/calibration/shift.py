@@ -36,6 +36,7 @@ CORRECTION_SCALE_MAX = 0.5  # WC_CORRECTION_SCALE_MAX
 KISS_BAND_MAX_PA = 1e6     # WC_SHIFT_LIMIT_KISS_BAND_MAX_Pa
 CURRENT_MAX_MA = 2000.0    # WC_SHIFT_LIMIT_CURRENT_MAX_mA
 ENGINE_DELTA_MAX_NM = 1000.0  # WC_SHIFT_LIMIT_ENGINE_DELTA_MAX_Nm
+GEAR_STEP_MIN = 0.01         # WC_SHIFT_GEAR_STEP_MIN: the off-going and the target ratio differ by 1 % at least
 
 # (name in the file, unit, C field, check) in the C struct's order. check(value, values) -> bool.
 FIELDS: tuple[tuple[str, str, str, object], ...] = (
@@ -85,7 +86,8 @@ FIELDS: tuple[tuple[str, str, str, object], ...] = (
     # The whole shift (DESIGN 14, wc_shift.h): coordinator 0 = the on-coming clutch alone
     ("coordinator", "1", "coordinator", lambda v, c: v in (0, 1)),
     ("offgoing_ratio", "1", "offgoing_ratio",
-     lambda v, c: (v == 0.0 or 0.05 <= v <= 20.0) and (c["coordinator"] == 0 or v > c["output_ratio"])),
+     lambda v, c: (v == 0.0 or 0.05 <= v <= 20.0) and
+     (c["coordinator"] == 0 or (v != 0.0 and abs(v - c["output_ratio"]) >= GEAR_STEP_MIN * c["output_ratio"]))),
     ("fill_pulse_current", "mA", "fill_pulse_current_mA", lambda v, c: 0.0 <= v <= CURRENT_MAX_MA),
     ("fill_pulse_time", "s", "fill_pulse_time_s", lambda v, c: 0.0 <= v <= TIME_MAX_S and v <= c["prepare_time"]),
     ("offgoing_holding_factor", "1", "offgoing_holding_factor", lambda v, c: 0.0 <= v <= 5.0),

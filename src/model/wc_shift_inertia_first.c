@@ -1,0 +1,241 @@
+/* The inertia-phase-first shift (DESIGN 15; wc_shift.h): the kickdown in
+ * the controller's frame, the tip-out upshift mirrored by wc_transmission.
+ * The off-going clutch lets the turbine run to the target gear's speed on
+ * the reference slip; the on-coming clutch, filled at its kiss point, takes
+ * the torque over at synchronism. The transitions (command, safe state,
+ * fallback) and the inertia phase's end are the torque-first shift's
+ * (wc_shift_internal.h). */
+#include "wetclutch/wc_shift.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "wc_internal.h"
+#include "wc_shift_internal.h"
+
+/* DESIGN 15: the off-going clutch (slip w_t - b1 w_o, a = 1) carries T_1 while
+ * the on-coming one (slip w_t - b w_o) waits: I_t dw_t/dt = T_t - T_1,
+ * I_out dw_o/dt = b1 T_1 - T_road, so d(slip)/dt = T_t / I_t - T_1 (1 / I_t +
+ * b b1 / I_out) (+ the road load, small, left to the PI), and the
+ * feed-forward for the reference's rate is
+ * T_1 = (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out), >= 0. */
+static float offgoing_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float rate_rad_s2)
+{
+    const float i_t = cal->turbine_inertia_kg_m2;
+    const float inverse_inertia = 1.0f / i_t + cal->output_ratio * cal->offgoing_ratio / cal->output_inertia_kg_m2;
+    return wc_shift_clamp_torque_Nm((turbine_torque_Nm / i_t - rate_rad_s2) / inverse_inertia);
+}
+
+/* The torque the on-coming clutch carries once synchronous (the torque-first
+ * shift's feed-forward at a zero slip rate, DESIGN 10): a T_t / I_t /
+ * (a^2 / I_t + b^2 / I_out), a = 1. */
+static float oncoming_carried_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm)
+{
+    const float i_t = cal->turbine_inertia_kg_m2;
+    const float b = cal->output_ratio;
+    return wc_shift_clamp_torque_Nm((turbine_torque_Nm / i_t) / (1.0f / i_t + b * b / cal->output_inertia_kg_m2));
+}
+
+/* Only the turbine torque moves the turbine here (the off-going clutch can
+ * only hold it back): the reference's peak rate 1.5 |slip_0| / T must stay
+ * within T_t / I_t, with WC_SHIFT_FEASIBLE_MARGIN to spare for the PI. A
+ * target faster than that is stretched (at most to inertia_time_max_s): a
+ * light tip-out's drag or a kickdown's torque sets the pace, the feedback does
+ * not saturate at an empty clutch and time out (DESIGN 15). */
+#define WC_SHIFT_FEASIBLE_MARGIN 1.25f
+static float feasible_time_s(const wc_shift_calibration_t *cal, float target_time_s, float start_slip_rad_s,
+                             float turbine_torque_Nm)
+{
+    const float acceleration_rad_s2 = turbine_torque_Nm / cal->turbine_inertia_kg_m2;
+    const float need_s = WC_SHIFT_FEASIBLE_MARGIN * 1.5f * fabsf(start_slip_rad_s);
+    /* need / acceleration > max, written without the division (acceleration may be 0) */
+    if (!(need_s < cal->inertia_time_max_s * acceleration_rad_s2)) { return cal->inertia_time_max_s; }
+    const float feasible_s = need_s / acceleration_rad_s2;
+    return (feasible_s > target_time_s) ? feasible_s : target_time_s;
+}
+
+/* The smoothstep of the torque phase at its next period (0 .. 1). */
+static float handover_share(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
+{
+    const float t_s = (float)(shift->phase_periods + 1u) * dt_s;
+    const float x = (cal->torque_phase_time_s > 0.0f) ? (t_s / cal->torque_phase_time_s) : 1.0f;
+    const float xc = (x < 1.0f) ? x : 1.0f;
+    return xc * xc * (3.0f - 2.0f * xc);
+}
+
+typedef struct {
+    float oncoming_Nm;   /* the on-coming clutch's request (WC_MODE_TORQUE) */
+    float offgoing_Nm;   /* the off-going clutch's request */
+    bool offgoing_locked;  /* hand-back: the off-going clutch at its maximum current */
+    bool offgoing_open;
+} requests_t;
+
+/* The phase's law; may change the phase (PREPARE -> INERTIA). */
+static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, float dt_s,
+                                 bool offgoing_saturated)
+{
+    requests_t r = { 0.0f, 0.0f, false, true };
+    const float t_t_Nm = shift->turbine_torque_Nm;
+    const uint32_t phase = shift->phase;
+    if ((phase == (uint32_t)WC_SHIFT_IDLE) || (phase == (uint32_t)WC_SHIFT_ABORTED)) {
+        r.offgoing_locked = !shift->second_gear;  /* hand-back, or the source gear held until the shift starts */
+        r.offgoing_open = shift->second_gear;
+        return r;
+    }
+    if (phase == (uint32_t)WC_SHIFT_PREPARE) {
+        const uint32_t n = wc_shift_periods_of(cal->prepare_time_s, dt_s);
+        if (shift->phase_periods < n) {
+            const float x = (float)(shift->phase_periods + 1u) / (float)n;
+            const float from_Nm = cal->offgoing_holding_factor * t_t_Nm;
+            const float to_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
+            r.offgoing_Nm = from_Nm + (to_Nm - from_Nm) * x;
+            r.offgoing_open = false;
+            return r;
+        }
+        /* inertia phase: the reference starts at the measured slip (below the target gear's speed); bumpless:
+         * the integral takes what the feed-forward does not give of the last request */
+        wc_shift_enter(shift, WC_SHIFT_INERTIA);
+        shift->start_slip_rad_s = slip_rad_s;
+        shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, t_t_Nm);
+        shift->request_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * offgoing_feedforward_Nm(cal, t_t_Nm, 0.0f);
+        if (!(slip_rad_s < -cal->min_start_slip_rad_s)) {
+            wc_shift_abort(shift, WC_SHIFT_ABORT_NO_SLIP);
+            r.offgoing_locked = true;  /* handed back */
+            r.offgoing_open = false;
+            return r;
+        }
+    }
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
+        float rate_rad_s2;
+        const float elapsed_s = (float)shift->phase_periods * dt_s;
+        const float reference = wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
+        const float ff_Nm = cal->feedforward_gain * offgoing_feedforward_Nm(cal, t_t_Nm, rate_rad_s2);
+        /* slip above the reference: the turbine runs ahead, the off-going clutch holds more */
+        const float error = slip_rad_s - reference;
+        shift->error_sq_sum += error * error;
+        shift->inertia_periods++;
+        const bool blocked = (offgoing_saturated && (error > 0.0f)) || ((shift->request_Nm <= 0.0f) && (error < 0.0f));
+        if (!blocked) {
+            const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error * dt_s;
+            const float limit = cal->integral_limit_Nm;
+            shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
+        }
+        if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }  /* past synchronism */
+        r.offgoing_Nm = ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
+        r.offgoing_open = false;
+        return r;
+    }
+    /* TORQUE (the hand-over at synchronism), LOCKED */
+    const float hold_Nm = cal->holding_torque_factor * oncoming_carried_Nm(cal, t_t_Nm);
+    const float x = (phase == (uint32_t)WC_SHIFT_TORQUE) ? handover_share(shift, cal, dt_s) : 1.0f;
+    /* the turbine running past synchronism (slip > 0: the off-going clutch lets go while T_t still drives) is
+     * taken by the on-coming clutch in closed loop (the torque-first shift's flare correction, DESIGN 14) */
+    const float past_rad_s = (slip_rad_s > 0.0f) ? slip_rad_s : 0.0f;
+    if (phase == (uint32_t)WC_SHIFT_TORQUE) {
+        const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * past_rad_s * dt_s;
+        shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
+        if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
+    }
+    r.oncoming_Nm = hold_Nm * x + cal->flare_kp_Nm_per_rad_s * past_rad_s + shift->flare_integral_Nm;
+    r.offgoing_Nm = shift->phase_start_request_Nm * (1.0f - x);
+    r.offgoing_open = !(x < 1.0f);
+    return r;
+}
+
+static void set_input(wc_step_input_t *in, wc_clutch_mode_t mode, float request_Nm, float carried_Nm,
+                      const wc_lag_compensation_t *lag)
+{
+    const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
+    in->mode = mode;
+    in->torque_request_Nm = (mode == WC_MODE_TORQUE) ? wc_shift_clamp_torque_Nm(request_Nm) : 0.0f;
+    in->carried_torque_Nm = (mode == WC_MODE_TORQUE) ? wc_shift_clamp_torque_Nm(carried_Nm) : 0.0f;
+    in->lag_compensation = *lag;
+    in->theta_from_oil = false;
+    in->correction = none;
+}
+
+/* After the steps: the inertia phase's end (synchronism: the torque phase),
+ * the hand-over's end (LOCKED, or AbortReason 2). */
+static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool locked,
+                      float slip_rad_s, float dt_s)
+{
+    const bool fallback = shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE;
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
+        /* the on-coming clutch waits at its kiss point: its model does not lock; synchronism ends the phase */
+        if (wc_shift_inertia_over(shift, cal, clutch, false, slip_rad_s, dt_s)) {
+            shift->phase_start_request_Nm = shift->request_Nm;
+            shift->second_gear = true;  /* from here the on-coming clutch takes the gear: a lost input finishes */
+            wc_shift_enter(shift, WC_SHIFT_TORQUE);
+        }
+    } else if (shift->phase == (uint32_t)WC_SHIFT_TORQUE) {
+        const uint32_t ramp = wc_shift_periods_of(cal->torque_phase_time_s, dt_s);
+        if (fallback) {
+            /* the slip is not known: the ramps go on, never reported locked (issue 29 item 7) */
+        } else if (locked && (shift->phase_periods + 1u >= ramp)) {
+            wc_shift_enter(shift, WC_SHIFT_LOCKED);
+        } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
+            wc_shift_abort(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
+        }
+    }
+}
+
+bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
+                                 const wc_shift_command_t *command, bool safe, wc_clutch_t *clutch,
+                                 wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
+                                 wc_shift_offgoing_t *offgoing)
+{
+    WC_ASSERT((shift != NULL) && (cal != NULL) && (command != NULL) && (clutch != NULL) && (in != NULL) &&
+              (out != NULL) && (report != NULL) && (offgoing != NULL));
+    if ((shift == NULL) || (cal == NULL) || (command == NULL) || (clutch == NULL) || (in == NULL) || (out == NULL) ||
+        (report == NULL) || (offgoing == NULL) || (offgoing->clutch == NULL) || (offgoing->in == NULL) ||
+        (offgoing->out == NULL)) {
+        return false;
+    }
+    const uint32_t phase_before = shift->phase;
+    const float dt_s = (clutch->model.cal != NULL) ? clutch->model.cal->control_period_s : 1e-3f;  /* init failed: any */
+    const float slip_rad_s = wc_slip_valid(in->slip_rad_s) ? in->slip_rad_s : clutch->held.slip_rad_s;
+    const float s1 = offgoing->in->slip_rad_s;
+    shift->offgoing_slip_rad_s = wc_slip_valid(s1) ? s1 : offgoing->clutch->held.slip_rad_s;
+    if (safe) {
+        shift->fallback_periods = (shift->fallback_periods < UINT32_MAX) ? (shift->fallback_periods + 1u) : UINT32_MAX;
+    } else if (!wc_shift_phase_running(shift->phase)) {
+        shift->fallback_periods = 0u;
+    }
+    wc_shift_transitions(shift, cal, command, safe, true, slip_rad_s, dt_s, clutch, NULL, offgoing);
+
+    /* the clutches' inputs: the phase's law; the safe state holds the source gear until the hand-over */
+    const bool offgoing_saturated = (offgoing->out->status & WC_STATUS_SATURATED) != 0u;
+    const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated);
+    const bool on_active = (shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_INERTIA) ||
+                           (shift->phase == (uint32_t)WC_SHIFT_TORQUE) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED);
+    const float carried_on_Nm = oncoming_carried_Nm(cal, shift->turbine_torque_Nm);
+    set_input(in, on_active ? WC_MODE_TORQUE : WC_MODE_OPEN, r.oncoming_Nm, carried_on_Nm, &shift->lag_compensation);
+    const bool hand_back = (safe && !shift->second_gear) || r.offgoing_locked;
+    const wc_clutch_mode_t off_mode = hand_back ? WC_MODE_LOCKED : (r.offgoing_open ? WC_MODE_OPEN : WC_MODE_TORQUE);
+    /* it carries the turbine torque while it holds (the lock-up's decision: below it, it slips) */
+    set_input(offgoing->in, off_mode, r.offgoing_Nm, shift->turbine_torque_Nm, &shift->offgoing_lag);
+    if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) { shift->request_Nm = wc_shift_clamp_torque_Nm(r.offgoing_Nm); }
+
+    (void)wc_clutch_step(clutch, in, out);
+    wc_shift_fill_pulse(shift, cal, clutch, dt_s, out);
+    (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
+    offgoing->engine_active = false;  /* no engine request in this type yet (wc_shift.h) */
+    offgoing->engine_delta_Nm = 0.0f;
+
+    const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
+    const uint32_t phase_stepped = shift->phase;
+    phase_end(shift, cal, clutch, locked, slip_rad_s, dt_s);
+
+    /* the quality vector: both clutches' heat (eq. 1), the output torque T_c + (b1 / b) T_1's jerk */
+    const float heat_W = fabsf(out->model.torque_Nm * slip_rad_s) + fabsf(offgoing->out->model.torque_Nm * shift->offgoing_slip_rad_s);
+    const float theta_degC = (clutch->theta_degC > offgoing->clutch->theta_degC) ? clutch->theta_degC
+                                                                                : offgoing->clutch->theta_degC;
+    const float output_Nm = out->model.torque_Nm + cal->offgoing_ratio / cal->output_ratio * offgoing->out->model.torque_Nm;
+    const bool ended = wc_shift_account(shift, cal, phase_before, phase_stepped, heat_W, theta_degC, output_Nm, dt_s);
+    if (ended) {
+        shift->report.adaptation = wc_adapt_finish(NULL, cal, shift->report.abort_reason, clutch);
+        *report = shift->report;
+    }
+    return ended;
+}
