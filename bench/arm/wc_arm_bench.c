@@ -189,6 +189,11 @@ const char *const row_name[ROWS] = {
     [ROW_LOOP_DIAG_IDLE] = "wc_loop_step+diag:idle",
     [ROW_LOOP_DIAG_READ_DID] = "wc_loop_step+diag:read_did_multiframe",
     [ROW_LOOP_DIAG_READ_DTC] = "wc_loop_step+diag:read_dtc_list",
+    [ROW_TX_IN_GEAR] = "wc_transmission_step:in_gear",
+    [ROW_TX_POWER_ON_UP] = "wc_transmission_step:power_on_up",
+    [ROW_TX_POWER_OFF_UP] = "wc_transmission_step:power_off_up",
+    [ROW_TX_POWER_ON_DOWN] = "wc_transmission_step:power_on_down",
+    [ROW_TX_POWER_OFF_DOWN] = "wc_transmission_step:power_off_down",
 };
 
 /* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods; the whole
@@ -362,6 +367,7 @@ int main(void)
         whole_ram();
         bench_xcp();
         bench_diag();
+        bench_transmission();
 
         wc_arm_puts("GRID ");
         wc_arm_put_u32((uint32_t)GRID_POINTS);

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include <wetclutch/wetclutch.h>
+#include <wetclutch/wc_transmission.h>
 #include <wetclutch_can/wc_cal_image.h>
 #include <wetclutch_can/wc_can_signals.h>
 #include <wetclutch_can/wc_loop.h>
@@ -80,6 +81,11 @@ typedef enum {
     ROW_LOOP_DIAG_IDLE,
     ROW_LOOP_DIAG_READ_DID,
     ROW_LOOP_DIAG_READ_DTC,
+    ROW_TX_IN_GEAR,
+    ROW_TX_POWER_ON_UP,
+    ROW_TX_POWER_OFF_UP,
+    ROW_TX_POWER_ON_DOWN,
+    ROW_TX_POWER_OFF_DOWN,
     ROWS
 } row_t;
 
@@ -141,6 +147,12 @@ typedef struct {
     wc_dtc_t *dtc;
     wc_can_frame_t diag_tx[WC_ISOTP_MAX_FRAMES_PER_STEP];
     uint32_t diag_frames;
+    wc_transmission_t *transmission;         /* the transmission rows (wc_arm_bench_transmission.c) */
+    const wc_transmission_config_t *tx_config;
+    wc_transmission_command_t tx_command;
+    wc_transmission_input_t tx_input;
+    wc_transmission_output_t *tx_output;
+    bool tx_ended;
 } bench_ctx_t;
 
 typedef void (*thunk_t)(void *ctx);
@@ -171,6 +183,7 @@ void thunk_crc8(void *ctx);
 void thunk_uds_step(void *ctx);
 void thunk_diag_report(void *ctx);
 void thunk_loop_diag_step(void *ctx);
+void thunk_transmission_step(void *ctx);
 
 /* The measurement (wc_arm_bench.c): instructions of one call of thunk(ctx), the empty window subtracted;
  * a sample of a row; a failure (RESULT FAIL, the first reason kept). */
@@ -213,6 +226,7 @@ void bench_whole_shift_step(const wc_calibration_t *cal, row_t row);
 void bench_loop_whole_shift(const wc_calibration_t *cal, row_t row);
 void whole_ram(void);
 void bench_xcp(void);
+void bench_transmission(void);
 /* The diagnostic rows (wc_arm_bench_diag.c), and their integrator's wiring: the fault memory's tests from the
  * loop step's VfsCommand (c->tx) and the snapshot's operating point. */
 void bench_diag(void);

@@ -102,6 +102,7 @@ typedef struct {
     uint32_t gear;
     uint32_t type;                       /* wc_shift_type_t */
     uint32_t refusal;
+    uint64_t runnable;                   /* bit i: shift i's equivalent clutches are within the limits */
     float sign;                          /* 1, or -1: a power-off shift, mirrored */
     bool last_request;
 } wc_transmission_t;

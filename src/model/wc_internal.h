@@ -25,6 +25,13 @@ static inline bool wc_theta_valid(float theta_degC)
     return wc_in_range(theta_degC, WC_THETA_MIN_degC, WC_THETA_MAX_degC);
 }
 
+/* The model's terms of the pack's radii (eq. 3's R_eff, the squeeze film's
+ * damping, DESIGN 9) from cal, and model->cal = cal; the rest of the model
+ * kept. wc_model_init's last step; alone, for a checked calibration that
+ * differs from the model's own in the radii and the film factor only (an
+ * element's equivalent clutch, wc_transmission.c): no check, no expf. */
+void wc_model_set_geometry(wc_model_t *model, const wc_calibration_t *cal);
+
 /* One exact ZOH step of eq. 1 for validated inputs (wc_thermal_step checks
  * them; wc_clutch_step's are checked on entry), kept in the thermal envelope
  * (DESIGN section 8): the estimate stays where the maps are valid, and a heat

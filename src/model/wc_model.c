@@ -5,6 +5,7 @@
 
 #include "wetclutch/wc_config.h"
 #include "wetclutch/wc_film.h"
+#include "wc_internal.h"
 
 wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
 {
@@ -14,11 +15,6 @@ wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
     const wc_cal_error_t error = wc_calibration_check(cal);
     if (error != WC_CAL_OK) { return error; }
 
-    const float ro = cal->outer_radius_m;
-    const float ri = cal->inner_radius_m;
-    /* eq. 3: R_eff = 2/3 (Ro^3 - Ri^3) / (Ro^2 - Ri^2), written as
-     * 2/3 (Ro^2 + Ro Ri + Ri^2) / (Ro + Ri) to avoid cancellation in float. */
-    model->effective_radius_m = (2.0f / 3.0f) * (ro * ro + ro * ri + ri * ri) / (ro + ri);
     const float force_at_max_N = cal->vfs_gain_Pa_per_mA * cal->vfs_current_max_mA * cal->piston_area_m2 -
                                  cal->return_spring_force_N;
     model->force_max_N = (force_at_max_N > 0.0f) ? force_at_max_N : 0.0f;
@@ -27,6 +23,17 @@ wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
     const float k_total_W_per_K = cal->oil_conductance_W_per_K + cal->housing_conductance_W_per_K;
     model->thermal_decay = expf(-k_total_W_per_K * cal->control_period_s / cal->heat_capacity_J_per_K);
     model->vfs_decay = expf(-cal->control_period_s / cal->vfs_time_constant_s);
+    wc_model_set_geometry(model, cal);
+    return WC_CAL_OK;
+}
+
+void wc_model_set_geometry(wc_model_t *model, const wc_calibration_t *cal)
+{
+    const float ro = cal->outer_radius_m;
+    const float ri = cal->inner_radius_m;
+    /* eq. 3: R_eff = 2/3 (Ro^3 - Ri^3) / (Ro^2 - Ri^2), written as
+     * 2/3 (Ro^2 + Ro Ri + Ri^2) / (Ro + Ri) to avoid cancellation in float. */
+    model->effective_radius_m = (2.0f / 3.0f) * (ro * ro + ro * ri + ri * ri) / (ro + ri);
     /* DESIGN section 9: Reynolds' squeeze film between annular plates,
      * K = Ro^4 - Ri^4 - (Ro^2 - Ri^2)^2 / ln(Ro/Ri). For a narrow annulus the
      * two terms cancel (by 1/140 for Table 1's pack; to nothing in float as
@@ -48,5 +55,4 @@ wc_cal_error_t wc_model_init(wc_model_t *model, const wc_calibration_t *cal)
     }
     model->film_damping_m4 = 1.5f * 3.14159265f * cal->film_squeeze_factor * reynolds_m4;
     model->cal = cal;
-    return WC_CAL_OK;
 }

@@ -25,10 +25,9 @@ static const wc_gearbox_shift_t *row_from(const wc_gearbox_t *g, uint32_t gear)
     return NULL;
 }
 
-wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float slip_scale, wc_calibration_t *out)
+/* The equivalent clutch without its check (checked at init, per shift). */
+static void make_equivalent(const wc_calibration_t *element, float slip_scale, wc_calibration_t *out)
 {
-    WC_ASSERT((element != NULL) && (out != NULL));
-    if ((element == NULL) || (out == NULL)) { return WC_CAL_NULL; }
     /* DESIGN 15 (matrix8.py): the radii x |a| make R_eff (eq. 3) and with it the torque arm and the static
      * capacity x |a| while the sliding speed R_eff |slip / a| (eq. 4), and so mu_f (eq. 18), the viscous term
      * (eq. 5-8) and eq. 1's power, stay the element's; the squeeze film's Reynolds factor is of degree 4 in
@@ -38,17 +37,31 @@ wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float
     out->outer_radius_m = element->outer_radius_m * s;
     out->inner_radius_m = element->inner_radius_m * s;
     out->film_squeeze_factor = element->film_squeeze_factor / (s * s * s * s);
+}
+
+wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float slip_scale, wc_calibration_t *out)
+{
+    WC_ASSERT((element != NULL) && (out != NULL));
+    if ((element == NULL) || (out == NULL)) { return WC_CAL_NULL; }
+    make_equivalent(element, slip_scale, out);
     return wc_calibration_check(out);
 }
 
 /* Every shift's reduced model with the shift calibration (in the state's
- * copy, not on the stack: 244 B). */
+ * copy, not on the stack: 244 B), and which shifts have both equivalent
+ * clutches within the limits (tx->runnable; the others are refused with
+ * WC_GEARBOX_SHIFT_NO_MODEL): the checks once here, not in a control step. */
 static wc_transmission_error_t check_shifts(wc_transmission_t *tx, const wc_transmission_config_t *config)
 {
     const wc_gearbox_t *g = config->gearbox;
     for (uint32_t i = 0u; (i < g->shift_count) && (i < WC_GEARBOX_SHIFTS_MAX); ++i) {
-        if (wc_gearbox_shift_calibration(config->shift, &g->shift[i], &tx->shift_cal) != WC_SHIFT_CAL_OK) {
+        const wc_gearbox_shift_t *row = &g->shift[i];
+        if (wc_gearbox_shift_calibration(config->shift, row, &tx->shift_cal) != WC_SHIFT_CAL_OK) {
             return WC_TRANSMISSION_SHIFT;
+        }
+        if ((wc_transmission_equivalent(config->element[row->oncoming], row->oncoming_slip_scale, &tx->equivalent[0]) == WC_CAL_OK) &&
+            (wc_transmission_equivalent(config->element[row->offgoing], row->offgoing_slip_scale, &tx->equivalent[1]) == WC_CAL_OK)) {
+            tx->runnable |= (uint64_t)1u << i;
         }
     }
     return WC_TRANSMISSION_OK;
@@ -100,8 +113,7 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
                                                      : wc_gearbox_find_shift(g, tx->gear, command->target_gear, &row);
     }
     if ((result == WC_GEARBOX_SHIFT_OK) && (row != NULL) &&
-        ((wc_transmission_equivalent(config->element[row->oncoming], row->oncoming_slip_scale, &tx->equivalent[0]) != WC_CAL_OK) ||
-         (wc_transmission_equivalent(config->element[row->offgoing], row->offgoing_slip_scale, &tx->equivalent[1]) != WC_CAL_OK))) {
+        (((tx->runnable >> (uint32_t)(row - g->shift)) & 1u) == 0u)) {
         result = WC_GEARBOX_SHIFT_NO_MODEL;
     }
     tx->refusal = (uint32_t)result;
@@ -111,8 +123,10 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
                            (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_DOWN);
     tx->sign = power_off ? -1.0f : 1.0f;
     (void)wc_gearbox_shift_calibration(config->shift, row, &tx->shift_cal);
-    (void)wc_model_init(&tx->element[row->oncoming].model, &tx->equivalent[0]);
-    (void)wc_model_init(&tx->element[row->offgoing].model, &tx->equivalent[1]);
+    make_equivalent(config->element[row->oncoming], row->oncoming_slip_scale, &tx->equivalent[0]);
+    make_equivalent(config->element[row->offgoing], row->offgoing_slip_scale, &tx->equivalent[1]);
+    wc_model_set_geometry(&tx->element[row->oncoming].model, &tx->equivalent[0]);
+    wc_model_set_geometry(&tx->element[row->offgoing].model, &tx->equivalent[1]);
     wc_shift_init(&tx->shift);
     tx->row = row;
 }
@@ -205,8 +219,8 @@ static void end_shift(wc_transmission_t *tx, const wc_transmission_config_t *con
     const bool target = (tx->shift.phase == (uint32_t)WC_SHIFT_LOCKED) || tx->shift.second_gear;
     tx->gear = target ? row->target_gear : row->source_gear;
     tx->gear_row = row_from(config->gearbox, tx->gear);
-    (void)wc_model_init(&tx->element[row->oncoming].model, config->element[row->oncoming]);
-    (void)wc_model_init(&tx->element[row->offgoing].model, config->element[row->offgoing]);
+    wc_model_set_geometry(&tx->element[row->oncoming].model, config->element[row->oncoming]);
+    wc_model_set_geometry(&tx->element[row->offgoing].model, config->element[row->offgoing]);
     tx->row = NULL;
 }
 

@@ -5,13 +5,7 @@
  * type, and the power-on upshift bit for bit today's controller on the
  * shift's reduced model.
  *
- * The plant here only drives the phases (no validation of the model:
- * tools/wetclutch/simulate/gearbox_plant does that in closed loop): the
- * shift's own reduced two-speed model (turbine and output, no road load),
- * rigid in a gear; in a shift held at the source (target) gear's ratio while
- * the off-going (on-coming) element's modelled static capacity carries what
- * it must, else both speeds move with T_t and both elements' model torques in
- * the shift's reduced coordinates (the element torque x its a). */
+ * The plant: wc_test_transmission_rig.h (the shift's reduced two-speed model). */
 #include "wc_test_support.h"
 
 #include <string.h>
@@ -20,6 +14,7 @@
 #include "wc_8hp_gearbox.h"
 #include "wc_shift_1_2_shift.h"
 #include "wc_table1_calibration.h"
+#include "wc_test_transmission_rig.h"
 
 #define OUTPUT_rad_s 60.0f       /* 573 rpm at the output: 2nd gear's turbine 1794 rpm */
 #define OIL_degC 80.0f
@@ -53,46 +48,6 @@ static void rig_init(rig_t *r, uint32_t gear, float turbine_torque_Nm)
     r->turbine_torque_Nm = turbine_torque_Nm;
 }
 
-/* The two speeds' motion (file comment) after the step's outputs: the
- * shift's reduced model (turbine inertia I_t, the output's I_out, the
- * elements' torques in its coordinates), rigid in a gear. */
-static void plant(rig_t *r)
-{
-    const wc_transmission_t *tx = &r->tx;
-    const wc_gearbox_shift_t *row = (tx->row != NULL) ? tx->row : tx->gear_row;
-    const float i_t = row->turbine_inertia_kg_m2;
-    const float i_out = row->output_inertia_kg_m2;
-    const float t_t = r->turbine_torque_Nm;
-    if (tx->row == NULL) {  /* in a gear: rigid at its ratio */
-        const float ratio = wc_gearbox_8hp.ratio[tx->gear];
-        r->output_rad_s += ratio * t_t / (i_out + i_t * ratio * ratio) * DT_s;
-        r->turbine_rad_s = ratio * r->output_rad_s;
-        return;
-    }
-    const wc_step_output_t *on = &r->out.element[row->oncoming];
-    const wc_step_output_t *off = &r->out.element[row->offgoing];
-    /* the model torques in the controller's frame, x tx->sign back to the real one */
-    const float t_on = tx->sign * on->model.torque_Nm;
-    const float t_off = tx->sign * off->model.torque_Nm;
-    const float b = row->output_ratio;
-    const float b1 = row->offgoing_ratio;
-    const float s_on = r->turbine_rad_s - b * r->output_rad_s;
-    const float s_off = r->turbine_rad_s - b1 * r->output_rad_s;
-    /* held in the source gear: (I_out + I_t b1^2) dw_o/dt = b1 T_t + (b - b1) T_on; the off-going carries the rest */
-    const float a_source = (b1 * t_t + (b - b1) * t_on) / (i_out + i_t * b1 * b1);
-    const float a_target = (b * t_t + (b1 - b) * t_off) / (i_out + i_t * b * b);
-    if ((fabsf(s_off) < 0.5f) && (off->static_capacity_Nm >= fabsf(t_t - t_on - i_t * b1 * a_source))) {
-        r->output_rad_s += a_source * DT_s;
-        r->turbine_rad_s = b1 * r->output_rad_s;
-    } else if ((fabsf(s_on) < 0.5f) && (on->static_capacity_Nm >= fabsf(t_t - t_off - i_t * b * a_target))) {
-        r->output_rad_s += a_target * DT_s;
-        r->turbine_rad_s = b * r->output_rad_s;
-    } else {
-        r->turbine_rad_s += (t_t - t_on - t_off) / i_t * DT_s;
-        r->output_rad_s += (b * t_on + b1 * t_off) / i_out * DT_s;
-    }
-}
-
 /* One period with the request (current gear, target gear). */
 static bool rig_step(rig_t *r, bool request, uint32_t current, uint32_t target)
 {
@@ -108,7 +63,7 @@ static bool rig_step(rig_t *r, bool request, uint32_t current, uint32_t target)
     }
     assert_true(isfinite(r->out.engine_delta_Nm));
     if (ended) { r->ended++; }
-    plant(r);
+    wc_test_tx_plant(&wc_gearbox_8hp, &r->tx, &r->out, r->turbine_torque_Nm, DT_s, &r->turbine_rad_s, &r->output_rad_s);
     return ended;
 }
 

@@ -1,0 +1,100 @@
+/* The probe's transmission rows (wc_arm_bench.c; DESIGN 11, 15): wc_transmission_step with the 8HP
+ * table's five elements (lut/wc_8hp_gearbox.h), each Table 1's clutch, the shift calibration
+ * wc_shift_1_2_whole_full, driven by the C tests' plant (tests/c/wc_test_transmission_rig.h: the shift's
+ * reduced two-speed model), 80 degC:
+ *   :in_gear          3rd gear held at T_t 200 Nm (the three closed elements' inverse at their holding
+ *                     need x 1.2, the two open ones at the minimum): 256 steps
+ *   :power_on_up      2->3 at +150 Nm, every step from the request to the shift's end
+ *   :power_off_up     2->3 at -80 Nm (tip-out: the inertia-first controller, mirrored)
+ *   :power_on_down    3->2 at +150 Nm (kickdown: the inertia-first controller)
+ *   :power_off_down   3->2 at -40 Nm (coast: the torque-first controller, mirrored)
+ * Each shift must complete (AbortReason 0) in the target gear, else RESULT FAIL. RAM lines: the
+ * transmission's state and one element's part of it (its clutch and its input). */
+#include "wc_arm_bench.h"
+
+#include "wc_8hp_gearbox.h"
+#include "wc_shift_1_2_shift.h"
+#include "wc_test_transmission_rig.h"
+
+#define TX_OUTPUT_rad_s 60.0f
+#define TX_OIL_degC 80.0f
+#define TX_TARGET_s 0.4f
+#define TX_IN_GEAR_STEPS 256u
+#define TX_SETTLE_STEPS 300u      /* the VFS lag and the lock dwell in the start gear */
+#define TX_SHIFT_STEPS_MAX 4000u  /* the longest (a stretched tip-out) ends well before */
+
+static wc_transmission_t tx;
+static wc_transmission_config_t tx_config;
+static wc_transmission_output_t tx_output;
+
+void thunk_transmission_step(void *ctx)
+{
+    bench_ctx_t *c = (bench_ctx_t *)ctx;
+    c->tx_ended = wc_transmission_step(c->transmission, c->tx_config, &c->tx_command, &c->tx_input, c->tx_output, &c->shift_report);
+}
+
+typedef struct {
+    float turbine_rad_s;
+    float output_rad_s;
+    float turbine_torque_Nm;
+} tx_plant_t;
+
+/* One measured (or not) step with the request current -> target, then the plant. */
+static void tx_step(tx_plant_t *p, bool request, uint32_t current, uint32_t target, row_t row, bool measured)
+{
+    bench.tx_command = (wc_transmission_command_t){ request, current, target, p->turbine_torque_Nm, TX_TARGET_s };
+    bench.tx_input = (wc_transmission_input_t){ p->turbine_rad_s, p->output_rad_s, TX_OIL_degC, TX_OIL_degC, false };
+    if (measured) {
+        record(row, measure(thunk_transmission_step, &bench));
+    } else {
+        thunk_transmission_step(&bench);
+    }
+    wc_test_tx_plant(&wc_gearbox_8hp, &tx, &tx_output, p->turbine_torque_Nm, wc_arm_calibration->control_period_s,
+                     &p->turbine_rad_s, &p->output_rad_s);
+}
+
+/* Start in gear from, settle, then measure every step of the shift from -> to; it must complete. */
+static void tx_shift(uint32_t from, uint32_t to, float turbine_torque_Nm, row_t row)
+{
+    if (wc_transmission_init(&tx, &tx_config, from, TX_OIL_degC) != WC_TRANSMISSION_OK) {
+        fail("wc_transmission_init(8hp, table1)");
+        return;
+    }
+    (void)memset(&tx_output, 0, sizeof tx_output);
+    tx_plant_t p = { wc_gearbox_8hp.ratio[from] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, turbine_torque_Nm };
+    for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { tx_step(&p, false, from, to, row, false); }
+    bench.tx_ended = false;
+    for (uint32_t k = 0u; (k < TX_SHIFT_STEPS_MAX) && !bench.tx_ended; ++k) { tx_step(&p, true, from, to, row, true); }
+    if (!bench.tx_ended || (bench.shift_report.abort_reason != (uint32_t)WC_SHIFT_ABORT_NONE) || (tx.gear != to)) {
+        fail("a transmission row's shift did not complete in its target gear");
+    }
+}
+
+void bench_transmission(void)
+{
+    tx_config.gearbox = &wc_gearbox_8hp;
+    for (uint32_t e = 0u; e < wc_gearbox_8hp.element_count; ++e) { tx_config.element[e] = wc_arm_calibration; }
+    tx_config.shift = &wc_shift_1_2_whole_full;
+    tx_config.holding_margin_factor = 1.2f;
+    tx_config.holding_floor_Nm = 5.0f;
+    bench.transmission = &tx;
+    bench.tx_config = &tx_config;
+    bench.tx_output = &tx_output;
+
+    if (wc_transmission_init(&tx, &tx_config, 3u, TX_OIL_degC) != WC_TRANSMISSION_OK) {
+        fail("wc_transmission_init(8hp, table1)");
+        return;
+    }
+    (void)memset(&tx_output, 0, sizeof tx_output);
+    tx_plant_t p = { wc_gearbox_8hp.ratio[3] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 200.0f };
+    for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { tx_step(&p, false, 3u, 3u, ROW_TX_IN_GEAR, false); }
+    for (uint32_t k = 0u; k < TX_IN_GEAR_STEPS; ++k) { tx_step(&p, false, 3u, 3u, ROW_TX_IN_GEAR, true); }
+
+    tx_shift(2u, 3u, 150.0f, ROW_TX_POWER_ON_UP);
+    tx_shift(2u, 3u, -80.0f, ROW_TX_POWER_OFF_UP);
+    tx_shift(3u, 2u, 150.0f, ROW_TX_POWER_ON_DOWN);
+    tx_shift(3u, 2u, -40.0f, ROW_TX_POWER_OFF_DOWN);
+
+    put_ram("wc_transmission_t", (uint32_t)sizeof(wc_transmission_t));
+    put_ram("wc_transmission_t:per_element", (uint32_t)(sizeof(wc_clutch_t) + sizeof(wc_step_input_t)));
+}
