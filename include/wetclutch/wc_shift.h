@@ -379,12 +379,16 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  *             just above what it carries.
  *   INERTIA   the reference slip from the on-coming slip at the phase start
  *             (below -min_start_slip_rad_s, else AbortReason 6) to 0 as in
- *             the torque-first shift, in the commanded time or, when T_t
- *             cannot move the turbine that fast, the time it can (1.25 x
- *             1.5 |slip_0| I_t / T_t, at most inertia_time_max_s: only the
- *             turbine torque drives this phase); the off-going request = feed-forward
+ *             the torque-first shift; the hold-back = feed-forward
  *             (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out) + PI(slip -
- *             reference); the on-coming clutch at its kiss point. Ends as
+ *             reference) is the off-going request. Without oncoming_assist
+ *             (the kickdown: the engine sets the pace) the on-coming clutch
+ *             waits at its kiss point and a target faster than T_t can move
+ *             the turbine is stretched to the time it can (1.25 x 1.5
+ *             |slip_0| I_t / T_t, at most inertia_time_max_s); with it (the
+ *             tip-out: a small drag would take seconds) a negative hold-back
+ *             is the on-coming clutch's push, x (1 / I_t + b b1 / I_out) /
+ *             (1 / I_t + b^2 / I_out), in the commanded time. Ends as
  *             the torque-first inertia phase (the lock band's dwell, or the
  *             reference ended within min_start_slip_rad_s); flare: the slip
  *             above +flare_slip_rad_s (past synchronism).
@@ -407,7 +411,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  * does the inertia phase's work), its jerk that of the output torque
  * T_c + (b1 / b) T_1, tie_up never set (the plant measures it). */
 bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
-                                 const wc_shift_command_t *command, bool safe, wc_clutch_t *clutch,
+                                 const wc_shift_command_t *command, bool safe, bool oncoming_assist, wc_clutch_t *clutch,
                                  wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
                                  wc_shift_offgoing_t *offgoing);
 

@@ -10,7 +10,7 @@
  *   power-on upshift              wc_shift_step       as is (today's 1->2 controller)
  *   power-off downshift (coast)   wc_shift_step       mirrored
  *   power-on downshift (kickdown) inertia-first       as is
- *   power-off upshift (tip-out)   inertia-first       mirrored
+ *   power-off upshift (tip-out)   inertia-first       mirrored, the on-coming assist on
  *
  * Mirrored: the controller sees every speed, slip and torque negated (the
  * driveline's equations are odd in them, so a coast downshift is a power-on
@@ -23,6 +23,9 @@
  * (tools/wetclutch/shift/matrix8.py states the derivation); the element's
  * state (temperature, pressure, film, lock-up) carries over both ways.
  *
+ * During a shift the two elements it keeps closed are held at their maximum
+ * current (they carry the slipping elements' reactions and the inertia
+ * torques besides T_t's share: not bounded by T_t).
  * In a gear every closed element's slip is the gear's slip w_t - ratio w_o
  * (turbine and output speed tell that the box slips, not which element; a
  * slip shows on all three), an open element's its own (a w_t - b w_o of a

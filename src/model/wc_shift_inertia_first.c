@@ -14,16 +14,28 @@
 #include "wc_shift_internal.h"
 
 /* DESIGN 15: the off-going clutch (slip w_t - b1 w_o, a = 1) carries T_1 while
- * the on-coming one (slip w_t - b w_o) waits: I_t dw_t/dt = T_t - T_1,
- * I_out dw_o/dt = b1 T_1 - T_road, so d(slip)/dt = T_t / I_t - T_1 (1 / I_t +
- * b b1 / I_out) (+ the road load, small, left to the PI), and the
- * feed-forward for the reference's rate is
- * T_1 = (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out), >= 0. */
-static float offgoing_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float rate_rad_s2)
+ * the on-coming one (slip w_t - b w_o < 0) carries T_c: I_t dw_t/dt = T_t -
+ * T_1 + T_c, I_out dw_o/dt = b1 T_1 - b T_c - T_road, so d(slip)/dt = T_t / I_t
+ * - T_1 k_1 + T_c k_c, k_1 = 1 / I_t + b b1 / I_out, k_c = 1 / I_t + b^2 /
+ * I_out (+ the road load, small, left to the PI). The feed-forward for the
+ * reference's rate is the hold-back T_1 = (T_t / I_t - dref/dt) / k_1; a
+ * negative one (T_t cannot move the turbine that fast) is, with the
+ * on-coming assist, the on-coming clutch's push T_c = -T_1 k_1 / k_c. */
+static float holdback_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float rate_rad_s2)
 {
     const float i_t = cal->turbine_inertia_kg_m2;
-    const float inverse_inertia = 1.0f / i_t + cal->output_ratio * cal->offgoing_ratio / cal->output_inertia_kg_m2;
-    return wc_shift_clamp_torque_Nm((turbine_torque_Nm / i_t - rate_rad_s2) / inverse_inertia);
+    const float k_1 = 1.0f / i_t + cal->output_ratio * cal->offgoing_ratio / cal->output_inertia_kg_m2;
+    const float t_1 = (turbine_torque_Nm / i_t - rate_rad_s2) / k_1;
+    return (t_1 < WC_TORQUE_MAX_Nm) ? ((t_1 > -WC_TORQUE_MAX_Nm) ? t_1 : -WC_TORQUE_MAX_Nm) : WC_TORQUE_MAX_Nm;
+}
+
+/* k_1 / k_c (above): the on-coming clutch's push per newton metre of negative hold-back. */
+static float push_per_holdback(const wc_shift_calibration_t *cal)
+{
+    const float i_t = cal->turbine_inertia_kg_m2;
+    const float b = cal->output_ratio;
+    const float k_1 = 1.0f / i_t + b * cal->offgoing_ratio / cal->output_inertia_kg_m2;
+    return k_1 / (1.0f / i_t + b * b / cal->output_inertia_kg_m2);
 }
 
 /* The torque the on-coming clutch carries once synchronous (the torque-first
@@ -36,12 +48,12 @@ static float oncoming_carried_Nm(const wc_shift_calibration_t *cal, float turbin
     return wc_shift_clamp_torque_Nm((turbine_torque_Nm / i_t) / (1.0f / i_t + b * b / cal->output_inertia_kg_m2));
 }
 
-/* Only the turbine torque moves the turbine here (the off-going clutch can
- * only hold it back): the reference's peak rate 1.5 |slip_0| / T must stay
- * within T_t / I_t, with WC_SHIFT_FEASIBLE_MARGIN to spare for the PI. A
- * target faster than that is stretched (at most to inertia_time_max_s): a
- * light tip-out's drag or a kickdown's torque sets the pace, the feedback does
- * not saturate at an empty clutch and time out (DESIGN 15). */
+/* Without the on-coming assist only the turbine torque moves the turbine
+ * (the off-going clutch can only hold it back): the reference's peak rate
+ * 1.5 |slip_0| / T must stay within T_t / I_t, with WC_SHIFT_FEASIBLE_MARGIN
+ * to spare for the PI. A target faster than that is stretched (at most to
+ * inertia_time_max_s): a kickdown's engine torque sets the pace, the feedback
+ * does not saturate at an empty clutch and time out (DESIGN 15). */
 #define WC_SHIFT_FEASIBLE_MARGIN 1.25f
 static float feasible_time_s(const wc_shift_calibration_t *cal, float target_time_s, float start_slip_rad_s,
                              float turbine_torque_Nm)
@@ -72,7 +84,7 @@ typedef struct {
 
 /* The phase's law; may change the phase (PREPARE -> INERTIA). */
 static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, float dt_s,
-                                 bool offgoing_saturated)
+                                 bool offgoing_saturated, bool oncoming_saturated, bool assist)
 {
     requests_t r = { 0.0f, 0.0f, false, true };
     const float t_t_Nm = shift->turbine_torque_Nm;
@@ -96,9 +108,9 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
          * the integral takes what the feed-forward does not give of the last request */
         wc_shift_enter(shift, WC_SHIFT_INERTIA);
         shift->start_slip_rad_s = slip_rad_s;
-        shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, t_t_Nm);
+        if (!assist) { shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, t_t_Nm); }
         shift->request_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
-        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * offgoing_feedforward_Nm(cal, t_t_Nm, 0.0f);
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * holdback_feedforward_Nm(cal, t_t_Nm, 0.0f);
         if (!(slip_rad_s < -cal->min_start_slip_rad_s)) {
             wc_shift_abort(shift, WC_SHIFT_ABORT_NO_SLIP);
             r.offgoing_locked = true;  /* handed back */
@@ -110,19 +122,24 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s;
         const float reference = wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
-        const float ff_Nm = cal->feedforward_gain * offgoing_feedforward_Nm(cal, t_t_Nm, rate_rad_s2);
-        /* slip above the reference: the turbine runs ahead, the off-going clutch holds more */
+        const float ff_Nm = cal->feedforward_gain * holdback_feedforward_Nm(cal, t_t_Nm, rate_rad_s2);
+        /* slip above the reference: the turbine runs ahead, the off-going clutch holds more (with the assist:
+         * the on-coming one pushes less) */
         const float error = slip_rad_s - reference;
         shift->error_sq_sum += error * error;
         shift->inertia_periods++;
-        const bool blocked = (offgoing_saturated && (error > 0.0f)) || ((shift->request_Nm <= 0.0f) && (error < 0.0f));
+        const float holdback_Nm = ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
+        /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist */
+        const bool blocked = (offgoing_saturated && (error > 0.0f)) ||
+                             ((error < 0.0f) && (assist ? oncoming_saturated : (holdback_Nm <= 0.0f)));
         if (!blocked) {
             const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error * dt_s;
             const float limit = cal->integral_limit_Nm;
             shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
         }
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }  /* past synchronism */
-        r.offgoing_Nm = ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
+        r.offgoing_Nm = holdback_Nm;
+        r.oncoming_Nm = assist ? (-holdback_Nm * push_per_holdback(cal)) : 0.0f;  /* clamped at 0 by set_input */
         r.offgoing_open = false;
         return r;
     }
@@ -181,7 +198,7 @@ static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, cons
 }
 
 bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
-                                 const wc_shift_command_t *command, bool safe, wc_clutch_t *clutch,
+                                 const wc_shift_command_t *command, bool safe, bool oncoming_assist, wc_clutch_t *clutch,
                                  wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
                                  wc_shift_offgoing_t *offgoing)
 {
@@ -206,7 +223,9 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
 
     /* the clutches' inputs: the phase's law; the safe state holds the source gear until the hand-over */
     const bool offgoing_saturated = (offgoing->out->status & WC_STATUS_SATURATED) != 0u;
-    const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated);
+    const bool oncoming_saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's outputs */
+    const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated, oncoming_saturated,
+                                        oncoming_assist);
     const bool on_active = (shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_INERTIA) ||
                            (shift->phase == (uint32_t)WC_SHIFT_TORQUE) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED);
     const float carried_on_Nm = oncoming_carried_Nm(cal, shift->turbine_torque_Nm);

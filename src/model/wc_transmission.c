@@ -169,8 +169,8 @@ static void hold_gear(wc_transmission_t *tx, const wc_transmission_config_t *con
 }
 
 /* A shift's period: the controller of its type on the on-coming and
- * off-going elements (in its frame), the held elements at the larger of
- * the two gears' holding needs, the fourth open. Returns true when it ended. */
+ * off-going elements (in its frame), the held elements at their maximum
+ * current, the fourth open. Returns true when it ended. */
 static bool shift_step(wc_transmission_t *tx, const wc_transmission_config_t *config,
                        const wc_transmission_command_t *command, float w_t, float w_o, bool valid, bool safe,
                        wc_transmission_output_t *out, wc_shift_report_t *report)
@@ -186,10 +186,11 @@ static bool shift_step(wc_transmission_t *tx, const wc_transmission_config_t *co
         if ((e == on) || (e == off)) { continue; }
         wc_step_input_t *in = &tx->element_in[e];
         if (((g->closed_mask[row->source_gear] >> e) & 1u) != 0u) {
-            const float source_Nm = fabsf(g->holding_torque_per_Nm[row->source_gear][e]);
-            hold(in, config, (fabsf(g->holding_torque_per_Nm[row->target_gear][e]) > source_Nm) ? row->target_gear
-                                                                                                  : row->source_gear,
-                 e, command->turbine_torque_Nm, safe);
+            /* held through the shift at the maximum current: besides T_t's share it carries the reactions of
+             * the two slipping elements' torques and of the inertias, which T_t does not bound (a tip-out's
+             * on-coming push is several times the engine's drag); measured on the 8-speed plant, a held
+             * element at its in-gear holding broke away (transmission8) */
+            in->mode = WC_MODE_LOCKED;
             in->slip_rad_s = 0.0f;  /* held: not observable in the shift's two speeds (its slip map is 0, 0) */
         } else {
             in->mode = WC_MODE_OPEN;
@@ -205,8 +206,9 @@ static bool shift_step(wc_transmission_t *tx, const wc_transmission_config_t *co
     const bool ended = torque_first
         ? wc_shift_step(&tx->shift, &tx->shift_cal, &c, safe, &tx->element[on], NULL, &tx->element_in[on],
                         &out->element[on], report, &og)
-        : wc_shift_inertia_first_step(&tx->shift, &tx->shift_cal, &c, safe, &tx->element[on], &tx->element_in[on],
-                                      &out->element[on], report, &og);
+        /* the tip-out (mirrored) with the on-coming assist, the kickdown without (wc_shift.h) */
+        : wc_shift_inertia_first_step(&tx->shift, &tx->shift_cal, &c, safe, sign < 0.0f, &tx->element[on],
+                                      &tx->element_in[on], &out->element[on], report, &og);
     out->engine_active = og.engine_active;
     out->engine_delta_Nm = sign * og.engine_delta_Nm;  /* back to the real frame */
     return ended;

@@ -1,0 +1,222 @@
+"""Every shift type on the 8-speed plant with the firmware's transmission (issue 29; DESIGN 15).
+
+wc_transmission_step (include/wetclutch/wc_transmission.h) runs IN PROCESS through ctypes
+(build/host-release/src/host/libwc_transmission_host.so, src/host/wc_transmission_host.c) in lockstep with
+the 8-speed plant (wetclutch.simulate.gearbox_plant.Plant8), at the control period: the five elements'
+currents and the engine request go to the plant, the plant's turbine and output speed (the vehicle file's
+speed-sensor noise, 0.25 rpm steps), its oil and housing temperatures and the engine's torque estimate (the
+vehicle file's bias and noise) come back. Not the frame loop: the CAN frames of the transmission (current
+gear in ShiftCommand, the two speeds, one VFS command per element) are not there yet; this is the
+controllers' closed loop on a plant richer than their model, nothing more.
+
+The TCU's calibrations: each element's own clutch from the gearbox description (tools/gearboxes/8hp.toml,
+its image as the firmware decodes it), the shift calibration whole_full of tools/calibrations/shift_1_2.toml
+(its driveline replaced per shift by the table's reduced model, in C), the 8HP table of lut/wc_8hp_gearbox.h
+(the nominal vehicle's inertias: on the heavy and light vehicles the TCU's reduced model is off, as a real
+TCU's is). Holding in a gear: the holding need x 1.3, at least 10 Nm.
+
+Scenarios (SCENARIOS): per type, the shift, the pedal and the turbine speed at the request:
+  power-on upshift    g -> g+1, the pedal for `load` of full load at 2500 rpm
+  power-off upshift   g -> g+1, pedal 0 (tip-out: the engine drags) at 2500 rpm
+  power-on downshift  g -> g-1, pedal 1 (kickdown) at 1800 rpm
+  power-off downshift g -> g-1, pedal 0 (coast) at 1300 rpm
+
+Quality (from the plant's truth): completed (AbortReason 0) and the end gear by truth (every closed element
+locked, the speed ratio the gear's within 0.5 %); the peak vehicle jerk (as quality.py: the acceleration
+low-passed at JERK_CUTOFF_HZ, then its rate) from the request to 0.2 s after the end; the turbine's excursion outside the band between the two gears' speeds (flare above the
+higher, sag below the lower), rpm; the inertia time (the controller's report) against the commanded target;
+per element its friction energy; the on-coming element's peak temperature, estimate and truth. Tie-up is not
+measured here yet.
+"""
+from __future__ import annotations
+
+import argparse
+import ctypes
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..calibration import cal_image, shift as shift_calibration
+from ..gearbox import kinematics
+from ..simulate.gearbox_plant import Plant8
+from .matrix8 import (CONTROLLER, END_RATIO_TOLERANCE, LOCKUP_MA, OIL_DEGC, RPM, _element_clutch_values,
+                      _plant_and_models, pedal_for_load, plant_path)
+from .quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
+from .scenarios import ROOT, SHIFT_TOML, ShiftError
+
+LIBRARY = ROOT / "build" / "host-release" / "src" / "host" / "libwc_transmission_host.so"
+ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
+HOLDING_MARGIN, HOLDING_FLOOR_NM = 1.3, 10.0
+TARGET_S = 0.5
+AFTER_S = 0.3                                # run on after the shift's end: the target gear holds
+TYPES = {0: "power-on upshift", 1: "power-off upshift", 2: "power-on downshift", 3: "power-off downshift"}
+# type -> (direction, pedal (None: for the load), turbine rpm at the request)
+SCENARIOS = {"power-on upshift": (+1, None, 2500.0), "power-off upshift": (+1, 0.0, 2500.0),
+             "power-on downshift": (-1, 1.0, 1800.0), "power-off downshift": (-1, 0.0, 1300.0)}
+
+
+class _Step(ctypes.Structure):
+    _fields_ = [("current_mA", ctypes.c_float * 5), ("theta_degC", ctypes.c_float * 5),
+                ("model_torque_Nm", ctypes.c_float * 5), ("engine_delta_Nm", ctypes.c_float),
+                ("engine_active", ctypes.c_uint32), ("gear", ctypes.c_uint32), ("phase", ctypes.c_uint32),
+                ("type", ctypes.c_uint32), ("refusal", ctypes.c_uint32), ("ended", ctypes.c_uint32),
+                ("report", ctypes.c_float * 9)]
+
+
+def _library(path: Path = LIBRARY):
+    if not Path(path).is_file():
+        raise ShiftError(f"{path} not built (cmake --preset host-release && cmake --build --preset host-release)")
+    lib = ctypes.CDLL(str(path))
+    lib.wc_host_tx_size.restype = ctypes.c_size_t
+    lib.wc_host_tx_step_size.restype = ctypes.c_size_t
+    if lib.wc_host_tx_step_size() != ctypes.sizeof(_Step):
+        raise ShiftError("libwc_transmission_host's step record differs from transmission8._Step")
+    f, u = ctypes.c_float, ctypes.c_uint32
+    lib.wc_host_tx_init.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
+    lib.wc_host_tx_step.argtypes = [ctypes.c_void_p, u, u, u, f, f, f, f, f, f, u, ctypes.POINTER(_Step)]
+    return lib
+
+
+class Transmission:
+    """wc_transmission_step in process on the gearbox's element calibrations and the shift calibration."""
+
+    def __init__(self, gearbox_path, gear: int, theta_start_degC: float, lib=None):
+        self.lib = lib or _library()
+        base = shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
+        images = [cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), e),
+                                               **cal_image._shift_values(None),          # noqa: SLF001
+                                               **cal_image.loop_values(None, False)}) for e in ELEMENTS]
+        images.append(cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), ELEMENTS[0]),
+                                                   **cal_image._shift_values(base),      # noqa: SLF001
+                                                   **cal_image.loop_values(None, True)}))
+        self.state = ctypes.create_string_buffer(self.lib.wc_host_tx_size())
+        lengths = (ctypes.c_uint32 * len(images))(*[len(b) for b in images])
+        rc = self.lib.wc_host_tx_init(self.state, b"".join(images), lengths, gear, theta_start_degC,
+                                      HOLDING_MARGIN, HOLDING_FLOOR_NM)
+        if rc != 0:
+            raise ShiftError(f"wc_host_tx_init refused the configuration (code {rc})")
+        self.out = _Step()
+
+    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> _Step:
+        self.lib.wc_host_tx_step(self.state, int(request), current, target, torque_Nm, target_s, w_t, w_o, oil,
+                                 housing, 0, ctypes.byref(self.out))
+        return self.out
+
+
+def _end_gear(plant, st) -> str | None:
+    for gear, closed in plant.gb.gears.items():
+        if all(st[f"{e}_locked"] > 0.5 for e in closed):
+            ratio = st["turbine_speed_rpm"] / st["output_speed_rpm"]
+            if abs(ratio / plant.ratios[gear] - 1.0) <= END_RATIO_TOLERANCE:
+                return gear
+    return None
+
+
+def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, oil_degC: float = OIL_DEGC,
+              seed: int = 1, lib=None) -> dict:
+    """One shift source -> target of the kind's scenario in closed loop: its quality dict (module docstring)."""
+    params, _models = _plant_and_models(str(plant_path(vehicle)))
+    direction, pedal, rpm = SCENARIOS[kind]
+    if target - source != direction * abs(target - source):
+        raise ShiftError(f"{kind}: {source}->{target} goes the other way")
+    v = params.vehicle
+    pedal = pedal_for_load(params, load, rpm) if pedal is None else pedal
+    src, tgt = str(source), str(target)
+    ratio_src = float(kinematics.ratio(params.gearbox, src))
+    ratio_tgt = float(kinematics.ratio(params.gearbox, tgt))
+    speed = rpm * RPM / ratio_src / v.final_drive * v.wheel_radius
+    plant = Plant8.in_gear(params, src, speed, pedal=pedal, lockup_current_mA=LOCKUP_MA, oil_degC=oil_degC)
+    tx = Transmission(params.gearbox.path, source, oil_degC, lib)
+    rng = np.random.default_rng(seed)
+    dt, n_pre = plant.dt, int(round(v.preroll_time / plant.dt))
+    n_max = n_pre + int(round((v.shift_duration + 2.0) / dt))
+    st, engine_delta, end_k, report, kind_seen = plant.state, 0.0, None, None, None
+    rows = []
+    for k in range(n_max):
+        z = rng.standard_normal(4)
+        q = v.slip_resolution
+        w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q) * q * RPM
+        w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q) * q * RPM
+        torque = st["engine_torque_Nm"] * (1.0 + v.torque_estimate_bias) + v.torque_estimate_noise * z[2]
+        o = tx.step(k >= n_pre, source, target, torque, TARGET_S, w_t, w_o, plant.oil_degC, plant.housing_degC)
+        if k == n_pre:
+            if o.refusal != 0:
+                raise ShiftError(f"{src}->{tgt}: refused (wc_gearbox_shift_result_t {o.refusal})")
+            kind_seen = TYPES[o.type]
+        currents = {e: float(o.current_mA[i]) for i, e in enumerate(ELEMENTS)}
+        engine_delta = float(o.engine_delta_Nm) if o.engine_active else 0.0
+        rows.append((k, o.phase, float(o.theta_degC[_oncoming_index(params, src, tgt)])))
+        if o.ended and end_k is None:
+            end_k, report = k, list(o.report)
+        st = plant.step(currents, LOCKUP_MA, pedal, engine_delta)
+        if end_k is not None and k >= end_k + int(round(AFTER_S / dt)):
+            break
+    truth = plant.record()
+    on = ELEMENTS[_oncoming_index(params, src, tgt)]
+    return _quality(plant, truth, rows, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt), kind_seen,
+                    {"vehicle": str(vehicle), "kind": kind, "load": load, "oil_degC": oil_degC, "pedal": pedal})
+
+
+def _oncoming_index(params, src: str, tgt: str) -> int:
+    closes = set(params.gearbox.gears[tgt]) - set(params.gearbox.gears[src])
+    return ELEMENTS.index(next(iter(closes)))
+
+
+def _quality(plant, truth, rows, report, end_k, n_pre, gears, ratios, kind_seen, case):
+    dt = plant.dt
+    src, tgt, on = gears
+    ratio_src, ratio_tgt = ratios
+    k1 = (end_k if end_k is not None else len(rows) - 1) + int(round(0.2 / dt))
+    sl = slice(n_pre + 1, min(k1 + 1, truth["t_s"].size))
+    w_t, w_o = truth["turbine_speed_rpm"][sl], truth["output_speed_rpm"][sl]
+    hi, lo = max(ratio_src, ratio_tgt) * w_o, min(ratio_src, ratio_tgt) * w_o
+    excursion = float(np.max(np.maximum(np.maximum(w_t - hi, lo - w_t), 0.0), initial=0.0))
+    st_end = {key: arr[-1] for key, arr in truth.items()}
+    # the 1->2 runs' and the power-on matrix's measure (quality.py): the acceleration low-passed, then its rate
+    jerk = np.gradient(_lowpass_zero_phase(truth["vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ), dt)
+    abort = int(report[7]) if report else -1
+    inertia = float(report[0]) if report else math.nan
+    energy = {e: float(truth[f"{e}_energy_J"][-1] - truth[f"{e}_energy_J"][n_pre]) * 1e-3 for e in ELEMENTS}
+    theta_est = max(r[2] for r in rows[n_pre:]) if len(rows) > n_pre else math.nan
+    return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort,
+            "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
+            "inertia_time_s": inertia, "target_s": TARGET_S,
+            "peak_jerk_m_s3": float(np.max(np.abs(jerk[sl]), initial=0.0)),
+            "excursion_rpm": excursion, "energy_kJ": energy, "oncoming": on,
+            "peak_theta_estimate_degC": theta_est,
+            "peak_theta_truth_degC": float(np.max(truth[f"{on}_theta_degC"][sl]))}
+
+
+CASES = ((2, 3, "power-on upshift"), (2, 3, "power-off upshift"), (3, 2, "power-on downshift"),
+         (3, 2, "power-off downshift"), (5, 6, "power-on upshift"), (6, 5, "power-off downshift"),
+         (6, 4, "power-on downshift"), (4, 6, "power-off upshift"))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m wetclutch.shift.transmission8", description=__doc__.split("\n")[0])
+    ap.add_argument("--vehicle", default="nominal", help="a vehicle of tools/plants/8hp or an 8-speed plant file")
+    ap.add_argument("--out", type=Path, help="write the figures as JSON here")
+    args = ap.parse_args(argv)
+    results = []
+    for source, target, kind in CASES:
+        try:
+            q = run_shift(args.vehicle, source, target, kind)
+        except ShiftError as e:
+            print(f"transmission8: {e}", file=sys.stderr)
+            return 2
+        results.append(q)
+        print(f"{q['shift']:>5} {kind:20s} type {q['type']:20s} abort {q['abort']:2d} end gear {q['end_gear']} "
+              f"duration {q['duration_s']:.3f} s inertia {q['inertia_time_s']:.3f} s jerk {q['peak_jerk_m_s3']:6.1f} "
+              f"excursion {q['excursion_rpm']:5.0f} rpm theta est/true {q['peak_theta_estimate_degC']:.1f}/"
+              f"{q['peak_theta_truth_degC']:.1f}")
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(json.dumps(results, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
