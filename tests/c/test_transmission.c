@@ -330,6 +330,81 @@ static void test_shift_without_model_refused(void **state)
     assert_int_equal(r.out.shift_phase, WC_SHIFT_PREPARE);
 }
 
+/* Arbitrary inputs (a fixed-seed xorshift: reproducible): speeds, torques,
+ * times and gears anywhere, NaN and infinities among them, requests toggling,
+ * the safe state coming and going. Every output finite and every current
+ * within the solenoid's range (rig_step asserts it), every refusal a known
+ * reason, the gear always a gear of the box; 200,000 steps. */
+static uint32_t next_random(uint32_t *x)
+{
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    return *x;
+}
+
+static float arbitrary(uint32_t *x, float span)
+{
+    const uint32_t r = next_random(x);
+    switch (r % 16u) {
+    case 0u: return NAN;
+    case 1u: return INFINITY;
+    case 2u: return -INFINITY;
+    case 3u: return 0.0f;
+    default: return span * ((float)(r >> 8) / 8388608.0f - 1.0f);  /* [-span, span) */
+    }
+}
+
+static void test_arbitrary_inputs_stay_finite(void **state)
+{
+    (void)state;
+    rig_t r;
+    rig_init(&r, 3u, 100.0f);
+    uint32_t x = 0x2545F491u;
+    bool request = false;
+    uint32_t target = 4u;
+    uint32_t current = 3u;
+    uint32_t ended = 0u, completed = 0u;
+    for (uint32_t k = 0u; k < 200000u; ++k) {
+        if ((next_random(&x) % 1024u) == 0u) { request = !request; }
+        if ((next_random(&x) % 2048u) == 0u) { target = next_random(&x) % 12u; }
+        if ((next_random(&x) % 256u) == 0u) { current = next_random(&x) % 12u; }
+        const bool wild = (next_random(&x) % 256u) == 0u;
+        const float w_t = wild ? arbitrary(&x, 2000.0f) : r.turbine_rad_s;
+        const float w_o = wild ? arbitrary(&x, 500.0f) : r.output_rad_s;
+        const float torque_Nm = ((next_random(&x) % 32u) == 0u) ? arbitrary(&x, 3000.0f) : r.turbine_torque_Nm;
+        const float time_s = ((next_random(&x) % 32u) == 0u) ? arbitrary(&x, 3.0f) : TARGET_TIME_s;
+        const float oil_degC = ((next_random(&x) % 64u) == 0u) ? arbitrary(&x, 400.0f) : OIL_degC;
+        const wc_transmission_command_t c = { request, current, target, torque_Nm, time_s };
+        const wc_transmission_input_t in = { w_t, w_o, oil_degC, oil_degC, (next_random(&x) % 500u) == 0u };
+        if (wc_transmission_step(&r.tx, &r.config, &c, &in, &r.out, &r.report)) {
+            ended++;
+            completed += (r.report.abort_reason == (uint32_t)WC_SHIFT_ABORT_NONE) ? 1u : 0u;
+        }
+        for (uint32_t e = 0u; e < wc_gearbox_8hp.element_count; ++e) {
+            const wc_step_output_t *o = &r.out.element[e];
+            assert_true(isfinite(o->current_mA) && isfinite(o->model.torque_Nm) && isfinite(o->theta_degC) &&
+                        isfinite(o->pressure_command_Pa) && isfinite(o->static_capacity_Nm));
+            assert_true((o->current_mA >= wc_table1_calibration.vfs_current_min_mA) &&
+                        (o->current_mA <= wc_table1_calibration.vfs_current_max_mA));
+        }
+        assert_true(isfinite(r.out.engine_delta_Nm));
+        assert_true(r.out.refusal <= (uint32_t)WC_GEARBOX_SHIFT_NO_MODEL);
+        assert_true((r.out.gear >= 1u) && (r.out.gear <= 8u));
+        assert_true(r.out.shift_phase <= (uint32_t)WC_SHIFT_ABORTED);
+        /* the plant follows the box (a shift moves it; outside one it stays in the gear) */
+        wc_test_tx_plant(&wc_gearbox_8hp, &r.tx, &r.out, 100.0f, DT_s, &r.turbine_rad_s, &r.output_rad_s);
+        if (!(fabsf(r.output_rad_s) < 200.0f) || !isfinite(r.turbine_rad_s)) {  /* keep the rig in range */
+            r.output_rad_s = OUTPUT_rad_s;
+            r.turbine_rad_s = wc_gearbox_8hp.ratio[r.tx.gear] * OUTPUT_rad_s;
+        }
+        current = ((next_random(&x) % 4u) == 0u) ? r.out.gear : current;  /* mostly an integrator that knows */
+    }
+    print_message("    %u shifts ended, %u completed\n", (unsigned)ended, (unsigned)completed);
+    assert_true(ended >= 10u);   /* the inputs reached the shifts, not only the refusals (24 ended, 1 completed at d2f2710) */
+    assert_true(completed >= 1u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -340,6 +415,7 @@ int main(void)
         cmocka_unit_test(test_power_on_upshift_is_todays_controller),
         cmocka_unit_test(test_init_refuses),
         cmocka_unit_test(test_shift_without_model_refused),
+        cmocka_unit_test(test_arbitrary_inputs_stay_finite),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
