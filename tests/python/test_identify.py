@@ -506,7 +506,8 @@ def test_full_campaign():
     assert r.returncode == 0, r.stderr
     assert fig["mu"]["experiments"] == 184
     assert all(fig["targets"].values()), fig["targets"]
-    assert fig["runtime_s"]["total"] < 60.0
+    # the runtime is printed, not asserted: a wall-clock time depends on the host (issue 28)
+    print(f"identification time {fig['runtime_s']['total']:.1f} s (goal 60 s)")
 
 
 def test_identify_engagement_edges_from_the_bench(tmp_path):

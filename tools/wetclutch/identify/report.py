@@ -138,7 +138,9 @@ def _targets(res: Result, params: dict, truth: dict | None) -> dict:
         for name in EDGE_PARAMETERS:
             if name in params and "within_5pct" in params[name]:
                 targets[f"{SYMBOLS[name]} within 5%"] = params[name]["within_5pct"]
-    targets[f"runtime < {TARGETS['runtime_s']:g} s"] = bool(res.timings["total"] < TARGETS["runtime_s"])
+    # The runtime (TARGETS["runtime_s"]) is a figure, printed and in figures.json, not a target that sets the exit
+    # code: a wall-clock time says how fast the host is, not what the code does (a loaded 2-core CI machine took
+    # 82 s for what takes 33 s alone, issue 28)
     return targets
 
 
@@ -231,7 +233,8 @@ def _md_header(res: Result, fig: dict) -> list[str]:
          f"Data: `{fig['data_dir']}`; base calibration `{fig['base_calibration']}`"
          + (f"; true parameters `{fig['true_parameters']}`" if fig["true_parameters"] else "") + "  ",
          f"Identification time: {fig['runtime_s']['total']:.2f} s on {os.cpu_count()} CPU(s) ("
-         + ", ".join(f"{k} {v:.2f} s" for k, v in fig["runtime_s"].items() if k != "total") + ")", ""]
+         + ", ".join(f"{k} {v:.2f} s" for k, v in fig["runtime_s"].items() if k != "total")
+         + f"; the goal {TARGETS['runtime_s']:g} s is a figure, not a target: wall clock)", ""]
     for c in fig["campaigns"]:
         L.append(f"- campaign `{c['index']}`: {c['kind']}, {c['experiments']} experiment(s)")
     L += ["", "## Parameters", "",
