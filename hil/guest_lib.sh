@@ -29,6 +29,23 @@ await_line() {
   file_has "$1" "$2"
 }
 
+# guest_python ARG...: the project's Python (.venv) with the guest's tmpfs copy of the modules the tools
+# import (hil/guest_pylib.py; .venv/guest-pylib.tar, written by scripts/setup.sh) first on PYTHONPATH, so
+# their imports need no 9p (tens of seconds of the emulated CPU a start); unpacked once a boot, again when the
+# tar is newer. Natively (no VCAN_IN_GUEST from hil/vcan_guest.sh) or without the tar (setup.sh not run
+# since): the Python as it is.
+guest_python() {
+  local root tar lib=/dev/shm/wc-pylib
+  root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+  tar=$root/.venv/guest-pylib.tar
+  if [ -n "${VCAN_IN_GUEST:-}" ] && [ -r "$tar" ] && [ -d /dev/shm ] && { { [ -e "$lib/.unpacked" ] && ! [ "$tar" -nt "$lib/.unpacked" ]; } ||
+       { rm -rf "$lib" && mkdir -p "$lib" && tar -xf "$tar" -C "$lib" && : > "$lib/.unpacked"; }; }; then
+    PYTHONPATH="$lib${PYTHONPATH:+:$PYTHONPATH}" "$root/.venv/bin/python" "$@"
+  else
+    "$root/.venv/bin/python" "$@"
+  fi
+}
+
 # ---- The start-up and shut-down of a session against wc_tcu (hil/uds_guest.sh, hil/xcp_guest.sh): the
 # common options, the inputs and programs checked, wc_tcu started (frame clock) and awaited, the player
 # started, and at the end both stopped and waited for. Sets and reads the caller's globals: guest_name,

@@ -27,7 +27,7 @@ while [ $# -gt 0 ]; do
   shift 2
 done
 guest_check "$work" input.log restart.log cal.img secret.key
-tester=("$repo/.venv/bin/python" "$repo/hil/uds_tester.py" --secret "$dir/secret.key" --iface "$iface")
+tester=(guest_python "$repo/hil/uds_tester.py" --secret "$dir/secret.key" --iface "$iface")
 record=(--record capture.log --record-id 0x110 --record-id 0x120 --record-id 0x123 --record-id 0x7DF
         --record-id 0x7E1 --record-id 0x7E9)
 # a short security delay (200 steps): the session waits it out at start, after a soft reset and after three

@@ -26,6 +26,8 @@ fail_iface() {
        "(it needs CONFIG_CAN_VCAN: modprobe vcan / ip link failed above)" >&2
 }
 
+export VCAN_IN_GUEST=1   # for hil/guest_lib.sh's guest_python: the tmpfs copy of the modules only in the guest
+
 if [ "${1:-}" = --serve ]; then
   dir=$2 VCAN_IFACE=$3
   if ! up_iface "$VCAN_IFACE"; then fail_iface "$VCAN_IFACE"; echo 125 > "$dir/failed"; exit 125; fi

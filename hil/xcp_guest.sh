@@ -6,8 +6,9 @@
 # (the A2L's addresses and the image's bytes there, tools/wetclutch/hil/xcp_session.py) and secret.bin (the
 # device secret: wc_tcu --secret-file locks CAL/PAG behind XCP seed & key, the master computes the key). wc_tcu --xcp runs
 # with the frame clock; wc_canplay plays input.log in a loop, each period once the TCU's VfsCommand for the
-# last one is on the bus, never faster than the log and, during DAQ, never more than a few hundred steps
-# ahead of the master's decoding (DESIGN 5: a slower guest makes the session slower, never different),
+# last one is on the bus, never faster than the log, only as far as the master needs steps (to its
+# SETTLE_STEPS from the start, then held between its waits) and, during DAQ, never more than a few hundred
+# steps ahead of its decoding (DESIGN 5: a slower guest makes the session slower, never different),
 # and records ClutchSensors, VfsCommand and the XCP frames; pyxcp runs the session
 # (hil/xcp_master.py), waiting on the TCU's steps, never on the clock. Output in DIR: result.json (the
 # session), capture.log, stats.json and tcu.txt (wc_tcu), play.txt (wc_canplay), session.txt (the master's
@@ -40,8 +41,16 @@ guest_start_tcu --xcp --secret-file secret.bin --calibration-image cal.img --the
 # the player and the master on one CPU (--cpu 0): a raw command reaches the TCU in order with the inputs
 guest_start_player input.log --cpu 0 --limit-fifo "$fifo_dir/limit" --record capture.log \
   --record-id 0x110 --record-id 0x120 --record-id 0x7F0 --record-id 0x7F1
-"$repo/.venv/bin/python" "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" --secret-file secret.bin \
+# The inputs held from the start at the step the master downloads the new margin at the earliest (its
+# SETTLE_STEPS, read by the shell): the TCU steps there while the master's Python starts, then waits for it
+# (the master lets the inputs through as far as it needs steps). The FIFO kept open (read-write: no wait for
+# the player's open) until the end, so the line stays in it until the player reads it.
+[[ $(<"$repo/hil/xcp_master.py") =~ SETTLE_STEPS\ =\ ([0-9]+) ]] || guest_die "no SETTLE_STEPS in hil/xcp_master.py"
+exec {hold_fd}<>"$fifo_dir/limit"
+echo "${BASH_REMATCH[1]}" >&"$hold_fd"
+guest_python "$repo/hil/xcp_master.py" --plan plan.json --out result.json --iface "$iface" --secret-file secret.bin \
   --daq-samples "$daq_samples" --limit-fifo "$fifo_dir/limit" --cpu 0 > session.txt 2>&1 || rc=$?
 guest_stop
+exec {hold_fd}>&-
 [ "$rc" -eq 0 ] || echo "xcp_guest: the XCP session failed (exit $rc), see $dir/session.txt" >&2
 exit "$rc"

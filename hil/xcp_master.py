@@ -41,6 +41,10 @@ import can  # noqa: E402
 
 XCP_COMMAND_ID, XCP_RESPONSE_ID, VFS_COMMAND_ID = 0x7F0, 0x7F1, 0x120   # hil/wetclutch.dbc
 DAQ_WINDOW_STEPS = 200  # flow control: the inputs may run this many steps ahead of the last decoded DAQ sample
+SETTLE_STEPS = 400      # the new margin is downloaded once the TCU has stepped this far (frame clock: the same step on
+                        # any guest): the clutch locked (StatusLocked from period 197 of test_xcp_session's input.log,
+                        # in-process; the margin is the locked clutch's holding force) and its current steady (from
+                        # period 19), so the old current is the held one and the new one the margin's
 WAIT_LIMIT_S = 600.0    # no progress for this long (no step, no DAQ sample): the TCU stopped (a failure, said so);
                         # a limit on progress, not on the whole wait, so a slow guest only takes longer
 DAQ_SIGNALS = ("current_mA", "pressure_model_Pa", "force_command_N", "contact_force_N", "theta_degC",
@@ -89,10 +93,36 @@ def _f32(xcp, address: int) -> float:
     return struct.unpack("<f", bytes(xcp.shortUpload(4, address)))[0]
 
 
-def _wait_steps(xcp, meas: dict, steps: int) -> None:
-    """Until the TCU's loop_steps counter has advanced by steps (each upload is answered between two steps)."""
+class _Inputs:
+    """The player's flow control (wc_canplay --limit-fifo; hil/xcp_guest.sh holds it at --settle-steps from
+    the start): the inputs are let through as far as the session needs steps and held between (XCP commands
+    are answered without steps), so the guest's CPU goes to the master, not to steps nothing waits for. A
+    limit is a step count mod 65536; without a FIFO (no flow control) every call does nothing."""
+
+    def __init__(self, limit_fifo: str | None):
+        # opened once: blocks until the player has it open
+        self.fd = os.open(limit_fifo, os.O_WRONLY) if limit_fifo else None
+
+    def hold_at(self, step: int | None) -> None:
+        """The last step the inputs may reach, None: no limit."""
+        if self.fd is not None:
+            os.write(self.fd, b"none\n" if step is None else f"{step & 0xFFFF}\n".encode())
+
+    def close(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+
+def _wait_steps(xcp, meas: dict, steps: int, inputs: _Inputs, until: int | None = None) -> None:
+    """Until the TCU's loop_steps counter has advanced by steps (each upload is answered between two steps),
+    or with until, has reached until (a step count since the start) if that is later; the inputs are let
+    through that far and held there."""
     address = meas["loop_steps"][0]
     start, end = _u32(xcp, address), time.monotonic() + WAIT_LIMIT_S
+    if until is not None:
+        steps = max(steps, until - start)
+    inputs.hold_at(start + steps)
     last = start
     while ((now := _u32(xcp, address)) - start) % (1 << 32) < steps:
         if now != last:   # progress: the limit starts again
@@ -168,9 +198,19 @@ def _lap(result: dict, phase: str) -> None:
 
 
 def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fifo: str | None = None,
-                secret: bytes = b"") -> dict:
+                secret: bytes = b"", settle_steps: int = SETTLE_STEPS) -> dict:
     """Fills result as it goes (a failure leaves what was seen before it)."""
     _lap(result, "start-up")
+    inputs = _Inputs(limit_fifo)
+    try:
+        _xcp_session(plan, iface, daq_samples, result, inputs, secret, settle_steps)
+    finally:
+        inputs.close()
+    return result
+
+
+def _xcp_session(plan: dict, iface: str, daq_samples: int, result: dict, inputs: _Inputs, secret: bytes,
+                 settle_steps: int) -> None:
     chars, meas = plan["characteristics"], plan["measurements"]
     cal_base, cal_size = plan["segments"]["calibration"]
     margin_address = chars["clutch.holding_margin"][0]
@@ -207,30 +247,31 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
         result["characteristic_mismatches"] = mismatches
         result["holding_margin_read"] = _f32(xcp, margin_address)
         # a new holding margin: downloaded, the whole page checked, used from the next control step
-        _wait_steps(xcp, meas, 20)   # the capture's old current: the page in use for a few steps
+        # the capture's old current: the page in use for a few steps, the current settled
+        _wait_steps(xcp, meas, 20, inputs, until=settle_steps)
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 0.5))
-        _wait_steps(xcp, meas, 20)
+        _wait_steps(xcp, meas, 20, inputs)
         result["after_download"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                     "accepted": _u32(xcp, meas["xcp_pages_accepted"][0]),
                                     "margin": _f32(xcp, margin_address)}
         # above its limit: written into the page, the page refused, the loop keeps the last good one
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 5.0))
-        _wait_steps(xcp, meas, 20)
+        _wait_steps(xcp, meas, 20, inputs)
         result["after_invalid"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                    "page_error": _u32(xcp, meas["xcp_page_error"][0]),
                                    "rejected": _u32(xcp, meas["xcp_pages_rejected"][0]),
                                    "margin_in_page": _f32(xcp, margin_address)}
         xcp.setMta(margin_address)
         xcp.download(struct.pack("<f", 0.5))      # the page valid again (the margin in use)
-        _wait_steps(xcp, meas, 20)
+        _wait_steps(xcp, meas, 20, inputs)
         result["after_restore"] = {"page_result": _u32(xcp, meas["xcp_page_result"][0]),
                                    "accepted": _u32(xcp, meas["xcp_pages_accepted"][0])}
         # DAQ of 8 signals at the control step's event (no command beside it: on an emulated CPU pyxcp's
         # Python cannot answer commands while it decodes 8 frames a millisecond)
         _lap(result, "connect, identity, calibration")
-        with _Daq(xcp, meas, limit_fifo) as daq:
+        with _Daq(xcp, meas, inputs) as daq:
             daq.run_until(daq_samples)
         result["daq"] = daq.summary()
         _lap(result, "daq")
@@ -246,13 +287,14 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
             "cal_page_invalid": _error_code(lambda: xcp.setCalPage(0x01, 0, 7)),
         }
         _lap(result, "error packets")
-        result["overload"] = _overload(xcp, meas)
+        result["overload"] = _overload(xcp, meas, inputs)
         result["counters"] = {name: _u32(xcp, meas[name][0]) for name in
                               ("xcp_errors", "xcp_ignored", "xcp_daq_overloads", "xcp_pages_accepted",
                                "xcp_pages_rejected", "loop_deadline_misses", "loop_steps", "loop_safe_steps")}
         xcp.disconnect()
     result["disconnected"] = True
     _lap(result, "overload, counters")
+    inputs.hold_at(None)   # _raw counts the steps after each frame: the inputs flow again
     # frames pyxcp would never send, on a socket of our own (pyxcp's would queue their answers as its own)
     with can.Bus(interface="socketcan", channel=iface, receive_own_messages=True,   # _raw: its command's echo
                  can_filters=[{"can_id": XCP_COMMAND_ID, "can_mask": 0x7FF},
@@ -270,18 +312,17 @@ def run_session(plan: dict, iface: str, daq_samples: int, result: dict, limit_fi
         result["raw"] = {k: [b.hex() for b in v] for k, v in raw.items()}
     _lap(result, "raw frames")
     result.pop("_since", None)
-    return result
 
 
 class _Daq:
     """One DAQ list of DAQ_SIGNALS at event 0 (the control step), set up and started
     by pyxcp's DaqProcessor; the samples (slave timestamp, values) as its policy receives them. With
-    limit_fifo (wc_canplay --limit-fifo), the inputs are held DAQ_WINDOW_STEPS ahead of the last decoded
+    the player's flow control (_Inputs), the inputs are held DAQ_WINDOW_STEPS ahead of the last decoded
     sample: a master slower than the TCU holds the TCU's steps instead of losing frames or its answers
     queueing behind seconds of samples (DESIGN 5)."""
 
-    def __init__(self, xcp, meas: dict, limit_fifo: str | None = None):
-        self.limit_fifo, self.limit = limit_fifo, None
+    def __init__(self, xcp, meas: dict, inputs: _Inputs):
+        self.inputs = inputs
         from pyxcp.daq_stim import DaqList
         self.xcp, self.meas = xcp, meas
         self.names = list(DAQ_SIGNALS)
@@ -291,15 +332,13 @@ class _Daq:
         xcp.transport.policy = self.policy
         self.policy.xcp_master = xcp
 
-    def _hold_at(self, step: int | None) -> None:
-        """The last step the inputs may reach (mod 65536, the DAQ timestamp's range), None: no limit."""
-        if self.limit is not None:
-            os.write(self.limit, b"none\n" if step is None else f"{step & 0xFFFF}\n".encode())
+    def _hold_at(self, step: int) -> None:
+        """The last step the inputs may reach (mod 65536, the DAQ timestamp's range)."""
+        self.inputs.hold_at(step)
 
     def __enter__(self):
-        if self.limit_fifo:   # held from here (commands are answered without steps), until DAQ runs
-            self.limit = os.open(self.limit_fifo, os.O_WRONLY)   # blocks until the player has it open
-            self._hold_at(_u32(self.xcp, self.meas["loop_steps"][0]) + DAQ_WINDOW_STEPS)
+        # held from here (commands are answered without steps), until DAQ runs
+        self._hold_at(_u32(self.xcp, self.meas["loop_steps"][0]) + DAQ_WINDOW_STEPS)
         self.misses_before = _u32(self.xcp, self.meas["loop_deadline_misses"][0])
         self.policy.setup()
         self.policy.start()
@@ -322,9 +361,7 @@ class _Daq:
 
     def __exit__(self, *exc):
         self.policy.stop()
-        self._hold_at(None)
-        if self.limit is not None:
-            os.close(self.limit)
+        self._hold_at(_u32(self.xcp, self.meas["loop_steps"][0]))   # held: error packets and counters need no step
         self.misses = _u32(self.xcp, self.meas["loop_deadline_misses"][0]) - self.misses_before
         return False
 
@@ -342,7 +379,7 @@ class _Daq:
                 "currents": sorted(set(current))}
 
 
-def _overload(xcp, meas: dict) -> dict:
+def _overload(xcp, meas: dict, inputs: _Inputs) -> dict:
     """A DAQ list of more ODTs than a step may send: it is never sampled, counted, EV_DAQ_OVERLOAD sent."""
     before = _u32(xcp, meas["xcp_daq_overloads"][0])
     odts = 16
@@ -357,7 +394,7 @@ def _overload(xcp, meas: dict) -> dict:
     xcp.setDaqListMode(0x10, 0, 0, 1, 0)
     xcp.startStopDaqList(0x02, 0)
     xcp.startStopSynch(0x01)
-    _wait_steps(xcp, meas, 50)
+    _wait_steps(xcp, meas, 50, inputs)
     xcp.startStopSynch(0x00)
     return {"odts": odts, "overloads": _u32(xcp, meas["xcp_daq_overloads"][0]) - before}
 

@@ -31,3 +31,8 @@ if [ ! -f "$stamp" ] || ! cmp -s tools/pyproject.toml "$stamp"; then
   "$venv/bin/python" -m pip install -q -e "tools[test]"
   cp tools/pyproject.toml "$stamp"
 fi
+# the guest tools' modules in one tar for the emulated guest's tmpfs (hil/guest_pylib.py): again after an install
+pylib="$venv/guest-pylib.tar"
+if [ ! -f "$pylib" ] || [ "$stamp" -nt "$pylib" ] || [ hil/guest_pylib.py -nt "$pylib" ]; then
+  "$venv/bin/python" hil/guest_pylib.py "$pylib"
+fi
