@@ -601,17 +601,7 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
         shift->phase_start_request_Nm = shift->request_Nm;
         wc_shift_enter(shift, WC_SHIFT_LOCKUP);
     } else if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
-        /* locked once the ramp is done (the lock-up's dwell and the film may end
-         * after it): within WC_SHIFT_LOCKUP_WAIT ramp times */
-        const uint32_t ramp = wc_shift_periods_of(cal->lockup_ramp_time_s, dt_s);
-        if (fallback) {
-            /* the slip is not known: the hand-over holds, never reported locked (issue 29 item 7); the
-             * input back restarts it (resume), else fall_back releases it after fallback_time_s */
-        } else if (locked && (shift->phase_periods + 1u >= ramp)) {
-            wc_shift_enter(shift, WC_SHIFT_LOCKED);
-        } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
-            wc_shift_abort(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
-        }
+        wc_shift_handover_end(shift, locked, wc_shift_periods_of(cal->lockup_ramp_time_s, dt_s));
     }
 
     const bool ended = wc_shift_account(shift, cal, phase_before, phase_stepped, fabsf(out->model.torque_Nm * slip_rad_s),

@@ -21,21 +21,16 @@
  * reference's rate is the hold-back T_1 = (T_t / I_t - dref/dt) / k_1; a
  * negative one (T_t cannot move the turbine that fast) is, with the
  * on-coming assist, the on-coming clutch's push T_c = -T_1 k_1 / k_c. */
-static float holdback_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_torque_Nm, float rate_rad_s2)
+static float holdback_k1(const wc_shift_calibration_t *cal)
 {
-    const float i_t = cal->turbine_inertia_kg_m2;
-    const float k_1 = 1.0f / i_t + cal->output_ratio * cal->offgoing_ratio / cal->output_inertia_kg_m2;
-    const float t_1 = (turbine_torque_Nm / i_t - rate_rad_s2) / k_1;
-    return (t_1 < WC_TORQUE_MAX_Nm) ? ((t_1 > -WC_TORQUE_MAX_Nm) ? t_1 : -WC_TORQUE_MAX_Nm) : WC_TORQUE_MAX_Nm;
+    return 1.0f / cal->turbine_inertia_kg_m2 + cal->output_ratio * cal->offgoing_ratio / cal->output_inertia_kg_m2;
 }
 
-/* k_1 / k_c (above): the on-coming clutch's push per newton metre of negative hold-back. */
-static float push_per_holdback(const wc_shift_calibration_t *cal)
+static float holdback_feedforward_Nm(const wc_shift_calibration_t *cal, float k_1, float turbine_torque_Nm,
+                                     float rate_rad_s2)
 {
-    const float i_t = cal->turbine_inertia_kg_m2;
-    const float b = cal->output_ratio;
-    const float k_1 = 1.0f / i_t + b * cal->offgoing_ratio / cal->output_inertia_kg_m2;
-    return k_1 / (1.0f / i_t + b * b / cal->output_inertia_kg_m2);
+    const float t_1 = (turbine_torque_Nm / cal->turbine_inertia_kg_m2 - rate_rad_s2) / k_1;
+    return (t_1 < WC_TORQUE_MAX_Nm) ? ((t_1 > -WC_TORQUE_MAX_Nm) ? t_1 : -WC_TORQUE_MAX_Nm) : WC_TORQUE_MAX_Nm;
 }
 
 /* The torque the on-coming clutch carries once synchronous (the torque-first
@@ -110,7 +105,7 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         shift->start_slip_rad_s = slip_rad_s;
         if (!assist) { shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, t_t_Nm); }
         shift->request_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
-        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * holdback_feedforward_Nm(cal, t_t_Nm, 0.0f);
+        shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * holdback_feedforward_Nm(cal, holdback_k1(cal), t_t_Nm, 0.0f);
         if (!(slip_rad_s < -cal->min_start_slip_rad_s)) {
             wc_shift_abort(shift, WC_SHIFT_ABORT_NO_SLIP);
             r.offgoing_locked = true;  /* handed back */
@@ -122,7 +117,8 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         float rate_rad_s2;
         const float elapsed_s = (float)shift->phase_periods * dt_s;
         const float reference = wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s, elapsed_s, &rate_rad_s2);
-        const float ff_Nm = cal->feedforward_gain * holdback_feedforward_Nm(cal, t_t_Nm, rate_rad_s2);
+        const float k_1 = holdback_k1(cal);
+        const float ff_Nm = cal->feedforward_gain * holdback_feedforward_Nm(cal, k_1, t_t_Nm, rate_rad_s2);
         /* slip above the reference: the turbine runs ahead, the off-going clutch holds more (with the assist:
          * the on-coming one pushes less) */
         const float error = slip_rad_s - reference;
@@ -139,7 +135,10 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         }
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }  /* past synchronism */
         r.offgoing_Nm = holdback_Nm;
-        r.oncoming_Nm = assist ? (-holdback_Nm * push_per_holdback(cal)) : 0.0f;  /* clamped at 0 by set_input */
+        /* the push per newton metre of negative hold-back: k_1 / k_c (above) */
+        const float b = cal->output_ratio;
+        const float k_c = 1.0f / cal->turbine_inertia_kg_m2 + b * b / cal->output_inertia_kg_m2;
+        r.oncoming_Nm = assist ? (-holdback_Nm * k_1 / k_c) : 0.0f;  /* clamped at 0 by set_input */
         r.offgoing_open = false;
         return r;
     }
@@ -177,7 +176,6 @@ static void set_input(wc_step_input_t *in, wc_clutch_mode_t mode, float request_
 static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool locked,
                       float slip_rad_s, float dt_s)
 {
-    const bool fallback = shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
         /* the on-coming clutch waits at its kiss point: its model does not lock; synchronism ends the phase */
         if (wc_shift_inertia_over(shift, cal, clutch, false, slip_rad_s, dt_s)) {
@@ -186,14 +184,7 @@ static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, cons
             wc_shift_enter(shift, WC_SHIFT_TORQUE);
         }
     } else if (shift->phase == (uint32_t)WC_SHIFT_TORQUE) {
-        const uint32_t ramp = wc_shift_periods_of(cal->torque_phase_time_s, dt_s);
-        if (fallback) {
-            /* the slip is not known: the ramps go on, never reported locked (issue 29 item 7) */
-        } else if (locked && (shift->phase_periods + 1u >= ramp)) {
-            wc_shift_enter(shift, WC_SHIFT_LOCKED);
-        } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp + 1u) {
-            wc_shift_abort(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
-        }
+        wc_shift_handover_end(shift, locked, wc_shift_periods_of(cal->torque_phase_time_s, dt_s));
     }
 }
 

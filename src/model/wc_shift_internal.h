@@ -79,6 +79,25 @@ void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
                           bool safe, bool coord, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
                           wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing);
 
+/* The hand-over's end, after the step (both controllers: the torque-first
+ * shift's LOCKUP, the inertia-first one's TORQUE): LOCKED once the clutch
+ * that takes the gear is locked and its ramp of ramp_periods done (the
+ * lock-up's dwell and the film may end after it), AbortReason 2 when not
+ * locked after WC_SHIFT_LOCKUP_WAIT ramps; during a fallback the slip is not
+ * known: the hand-over goes on, never reported locked (issue 29 item 7). */
+static inline void wc_shift_handover_end(wc_shift_t *shift, bool locked, uint32_t ramp_periods)
+{
+    if (shift->fallback != (uint32_t)WC_SHIFT_FALLBACK_NONE) {
+        /* the input back restarts it (resume), else the fallback releases it after fallback_time_s */
+    } else if (locked && (shift->phase_periods + 1u >= ramp_periods)) {
+        wc_shift_enter(shift, WC_SHIFT_LOCKED);
+    } else if (shift->phase_periods + 1u >= WC_SHIFT_LOCKUP_WAIT * ramp_periods + 1u) {
+        wc_shift_abort(shift, WC_SHIFT_ABORT_LOCKUP_FAILED);
+    } else {
+        /* ramping, or waiting for the lock */
+    }
+}
+
 /* The inertia phase's end, after the step (wc_shift.c; both controllers):
  * true when over (report.inertia_time_s set); an overrun aborts. */
 bool wc_shift_inertia_over(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool locked,

@@ -134,7 +134,8 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
     dt, n_pre = plant.dt, int(round(v.preroll_time / plant.dt))
     n_max = n_pre + int(round((v.shift_duration + 2.0) / dt))
     st, engine_delta, end_k, report, kind_seen = plant.state, 0.0, None, None, None
-    rows = []
+    theta_estimate = []          # the on-coming element's observer per period
+    on_index = _oncoming_index(params, src, tgt)
     for k in range(n_max):
         z = rng.standard_normal(4)
         q = v.slip_resolution
@@ -148,15 +149,15 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
             kind_seen = TYPES[o.type]
         currents = {e: float(o.current_mA[i]) for i, e in enumerate(ELEMENTS)}
         engine_delta = float(o.engine_delta_Nm) if o.engine_active else 0.0
-        rows.append((k, o.phase, float(o.theta_degC[_oncoming_index(params, src, tgt)])))
+        theta_estimate.append(float(o.theta_degC[on_index]))
         if o.ended and end_k is None:
             end_k, report = k, list(o.report)
         st = plant.step(currents, LOCKUP_MA, pedal, engine_delta)
         if end_k is not None and k >= end_k + int(round(AFTER_S / dt)):
             break
     truth = plant.record()
-    on = ELEMENTS[_oncoming_index(params, src, tgt)]
-    return _quality(plant, truth, rows, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt), kind_seen,
+    on = ELEMENTS[on_index]
+    return _quality(plant, truth, theta_estimate, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt), kind_seen,
                     {"vehicle": str(vehicle), "kind": kind, "load": load, "oil_degC": oil_degC, "pedal": pedal})
 
 
@@ -165,11 +166,11 @@ def _oncoming_index(params, src: str, tgt: str) -> int:
     return ELEMENTS.index(next(iter(closes)))
 
 
-def _quality(plant, truth, rows, report, end_k, n_pre, gears, ratios, kind_seen, case):
+def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, kind_seen, case):
     dt = plant.dt
     src, tgt, on = gears
     ratio_src, ratio_tgt = ratios
-    k1 = (end_k if end_k is not None else len(rows) - 1) + int(round(0.2 / dt))
+    k1 = (end_k if end_k is not None else len(theta_estimate) - 1) + int(round(0.2 / dt))
     sl = slice(n_pre + 1, min(k1 + 1, truth["t_s"].size))
     w_t, w_o = truth["turbine_speed_rpm"][sl], truth["output_speed_rpm"][sl]
     hi, lo = max(ratio_src, ratio_tgt) * w_o, min(ratio_src, ratio_tgt) * w_o
@@ -180,7 +181,7 @@ def _quality(plant, truth, rows, report, end_k, n_pre, gears, ratios, kind_seen,
     abort = int(report[7]) if report else -1
     inertia = float(report[0]) if report else math.nan
     energy = {e: float(truth[f"{e}_energy_J"][-1] - truth[f"{e}_energy_J"][n_pre]) * 1e-3 for e in ELEMENTS}
-    theta_est = max(r[2] for r in rows[n_pre:]) if len(rows) > n_pre else math.nan
+    theta_est = max(theta_estimate[n_pre:]) if len(theta_estimate) > n_pre else math.nan
     return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort,
             "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
             "inertia_time_s": inertia, "target_s": TARGET_S,
