@@ -50,12 +50,20 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_FRAME_ID (0x111u)
 #define WC_CAN_SHIFT_COMMAND_FRAME_ID (0x112u)
 #define WC_CAN_OFFGOING_SENSORS_FRAME_ID (0x113u)
+#define WC_CAN_GEARBOX_SENSORS_FRAME_ID (0x114u)
 #define WC_CAN_VFS_COMMAND_FRAME_ID (0x120u)
 #define WC_CAN_CLUTCH_ESTIMATE_FRAME_ID (0x121u)
 #define WC_CAN_SHIFT_REPORT_FRAME_ID (0x122u)
 #define WC_CAN_ADAPTATION_REPORT_FRAME_ID (0x123u)
 #define WC_CAN_OFFGOING_VFS_COMMAND_FRAME_ID (0x124u)
 #define WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID (0x125u)
+#define WC_CAN_GEARBOX_STATUS_FRAME_ID (0x126u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_FRAME_ID (0x128u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_FRAME_ID (0x129u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_FRAME_ID (0x12au)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_FRAME_ID (0x12bu)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_FRAME_ID (0x12cu)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_FRAME_ID (0x12du)
 #define WC_CAN_BENCH_MEASUREMENT_FRAME_ID (0x130u)
 #define WC_CAN_XCP_COMMAND_FRAME_ID (0x7f0u)
 #define WC_CAN_XCP_RESPONSE_FRAME_ID (0x7f1u)
@@ -68,12 +76,20 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_LENGTH (8u)
 #define WC_CAN_SHIFT_COMMAND_LENGTH (8u)
 #define WC_CAN_OFFGOING_SENSORS_LENGTH (8u)
+#define WC_CAN_GEARBOX_SENSORS_LENGTH (8u)
 #define WC_CAN_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_CLUTCH_ESTIMATE_LENGTH (8u)
 #define WC_CAN_SHIFT_REPORT_LENGTH (8u)
 #define WC_CAN_ADAPTATION_REPORT_LENGTH (8u)
 #define WC_CAN_OFFGOING_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH (8u)
+#define WC_CAN_GEARBOX_STATUS_LENGTH (8u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_LENGTH (8u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_LENGTH (8u)
 #define WC_CAN_BENCH_MEASUREMENT_LENGTH (8u)
 #define WC_CAN_XCP_COMMAND_LENGTH (8u)
 #define WC_CAN_XCP_RESPONSE_LENGTH (8u)
@@ -86,12 +102,20 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_IS_EXTENDED (0)
 #define WC_CAN_SHIFT_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_OFFGOING_SENSORS_IS_EXTENDED (0)
+#define WC_CAN_GEARBOX_SENSORS_IS_EXTENDED (0)
 #define WC_CAN_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_CLUTCH_ESTIMATE_IS_EXTENDED (0)
 #define WC_CAN_SHIFT_REPORT_IS_EXTENDED (0)
 #define WC_CAN_ADAPTATION_REPORT_IS_EXTENDED (0)
 #define WC_CAN_OFFGOING_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_ENGINE_TORQUE_REQUEST_IS_EXTENDED (0)
+#define WC_CAN_GEARBOX_STATUS_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_IS_EXTENDED (0)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_BENCH_MEASUREMENT_IS_EXTENDED (0)
 #define WC_CAN_XCP_COMMAND_IS_EXTENDED (0)
 #define WC_CAN_XCP_RESPONSE_IS_EXTENDED (0)
@@ -104,10 +128,18 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_CYCLE_TIME_MS (1u)
 #define WC_CAN_SHIFT_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_OFFGOING_SENSORS_CYCLE_TIME_MS (1u)
+#define WC_CAN_GEARBOX_SENSORS_CYCLE_TIME_MS (1u)
 #define WC_CAN_VFS_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_CLUTCH_ESTIMATE_CYCLE_TIME_MS (1u)
 #define WC_CAN_OFFGOING_VFS_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_ENGINE_TORQUE_REQUEST_CYCLE_TIME_MS (1u)
+#define WC_CAN_GEARBOX_STATUS_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_CYCLE_TIME_MS (1u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_CYCLE_TIME_MS (1u)
 #define WC_CAN_BENCH_MEASUREMENT_CYCLE_TIME_MS (1u)
 
 /* Signal choices. */
@@ -131,6 +163,14 @@ extern "C" {
 #define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE (4095u)
 
 #define WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE (-32768)
+
+#define WC_CAN_GEARBOX_SENSORS_OIL_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_GEARBOX_SENSORS_TURBINE_SPEED_SNA_CHOICE (-32768)
+
+#define WC_CAN_GEARBOX_SENSORS_OUTPUT_SPEED_SNA_CHOICE (-32768)
+
+#define WC_CAN_GEARBOX_SENSORS_HOUSING_TEMP_SNA_CHOICE (255u)
 
 #define WC_CAN_CLUTCH_ESTIMATE_ESTIMATED_CLUTCH_TEMP_SNA_CHOICE (4095u)
 
@@ -158,6 +198,81 @@ extern "C" {
 #define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_HAND_BACK_CHOICE (2u)
 #define WC_CAN_OFFGOING_VFS_COMMAND_FALLBACK_RELEASED_CHOICE (3u)
 
+#define WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_POWER_ON_UPSHIFT_CHOICE (0u)
+#define WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_POWER_OFF_UPSHIFT_CHOICE (1u)
+#define WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_POWER_ON_DOWNSHIFT_CHOICE (2u)
+#define WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_POWER_OFF_DOWNSHIFT_CHOICE (3u)
+
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_ACCEPTED_CHOICE (0u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_SAME_GEAR_CHOICE (1u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_NO_SUCH_GEAR_CHOICE (2u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_SWAP_CHOICE (3u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_DIRECTION_CHOICE (4u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_NOT_IN_TABLE_CHOICE (5u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_NOT_CURRENT_CHOICE (6u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_BUSY_CHOICE (7u)
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_NO_MODEL_CHOICE (8u)
+
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_OPEN_CHOICE (0u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_HELD_CHOICE (1u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_ONCOMING_CHOICE (2u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_OFFGOING_CHOICE (3u)
+
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_LOCKED_SLIPPING_CHOICE (0u)
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_LOCKED_LOCKED_CHOICE (1u)
+
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE (4095u)
+
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_SNA_CHOICE (-524288)
 
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_SNA_CHOICE (-524288)
@@ -169,12 +284,20 @@ extern "C" {
 #define WC_CAN_TORQUE_REQUEST_NAME "TorqueRequest"
 #define WC_CAN_SHIFT_COMMAND_NAME "ShiftCommand"
 #define WC_CAN_OFFGOING_SENSORS_NAME "OffgoingSensors"
+#define WC_CAN_GEARBOX_SENSORS_NAME "GearboxSensors"
 #define WC_CAN_VFS_COMMAND_NAME "VfsCommand"
 #define WC_CAN_CLUTCH_ESTIMATE_NAME "ClutchEstimate"
 #define WC_CAN_SHIFT_REPORT_NAME "ShiftReport"
 #define WC_CAN_ADAPTATION_REPORT_NAME "AdaptationReport"
 #define WC_CAN_OFFGOING_VFS_COMMAND_NAME "OffgoingVfsCommand"
 #define WC_CAN_ENGINE_TORQUE_REQUEST_NAME "EngineTorqueRequest"
+#define WC_CAN_GEARBOX_STATUS_NAME "GearboxStatus"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_NAME "ElementAVfsCommand"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_NAME "ElementBVfsCommand"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_NAME "ElementCVfsCommand"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_NAME "ElementDVfsCommand"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_NAME "ElementEVfsCommand"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_NAME "ElementFVfsCommand"
 #define WC_CAN_BENCH_MEASUREMENT_NAME "BenchMeasurement"
 #define WC_CAN_XCP_COMMAND_NAME "XcpCommand"
 #define WC_CAN_XCP_RESPONSE_NAME "XcpResponse"
@@ -199,9 +322,16 @@ extern "C" {
 #define WC_CAN_SHIFT_COMMAND_TARGET_GEAR_NAME "TargetGear"
 #define WC_CAN_SHIFT_COMMAND_TURBINE_TORQUE_NAME "TurbineTorque"
 #define WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_NAME "TargetInertiaTime"
+#define WC_CAN_SHIFT_COMMAND_CURRENT_GEAR_NAME "CurrentGear"
 #define WC_CAN_OFFGOING_SENSORS_CRC_NAME "Crc"
 #define WC_CAN_OFFGOING_SENSORS_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_NAME "OffgoingSlipSpeed"
+#define WC_CAN_GEARBOX_SENSORS_CRC_NAME "Crc"
+#define WC_CAN_GEARBOX_SENSORS_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_GEARBOX_SENSORS_OIL_TEMP_NAME "OilTemp"
+#define WC_CAN_GEARBOX_SENSORS_TURBINE_SPEED_NAME "TurbineSpeed"
+#define WC_CAN_GEARBOX_SENSORS_OUTPUT_SPEED_NAME "OutputSpeed"
+#define WC_CAN_GEARBOX_SENSORS_HOUSING_TEMP_NAME "HousingTemp"
 #define WC_CAN_VFS_COMMAND_CRC_NAME "Crc"
 #define WC_CAN_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
@@ -254,6 +384,70 @@ extern "C" {
 #define WC_CAN_ENGINE_TORQUE_REQUEST_ALIVE_COUNTER_NAME "AliveCounter"
 #define WC_CAN_ENGINE_TORQUE_REQUEST_INTERVENTION_ACTIVE_NAME "InterventionActive"
 #define WC_CAN_ENGINE_TORQUE_REQUEST_TORQUE_DELTA_NAME "TorqueDelta"
+#define WC_CAN_GEARBOX_STATUS_CRC_NAME "Crc"
+#define WC_CAN_GEARBOX_STATUS_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_GEARBOX_STATUS_GEAR_NAME "Gear"
+#define WC_CAN_GEARBOX_STATUS_TARGET_GEAR_NAME "TargetGear"
+#define WC_CAN_GEARBOX_STATUS_SHIFT_PHASE_NAME "ShiftPhase"
+#define WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_NAME "ShiftType"
+#define WC_CAN_GEARBOX_STATUS_REFUSAL_NAME "Refusal"
+#define WC_CAN_GEARBOX_STATUS_STATUS_SENSOR_TIMEOUT_NAME "StatusSensorTimeout"
+#define WC_CAN_GEARBOX_STATUS_STATUS_REQUEST_TIMEOUT_NAME "StatusRequestTimeout"
+#define WC_CAN_GEARBOX_STATUS_STATUS_CRC_ERROR_NAME "StatusCrcError"
+#define WC_CAN_GEARBOX_STATUS_STATUS_COUNTER_ERROR_NAME "StatusCounterError"
+#define WC_CAN_GEARBOX_STATUS_STATUS_IMPLAUSIBLE_INPUT_NAME "StatusImplausibleInput"
+#define WC_CAN_GEARBOX_STATUS_STATUS_SATURATED_NAME "StatusSaturated"
+#define WC_CAN_GEARBOX_STATUS_STATUS_CURRENT_CLAMPED_NAME "StatusCurrentClamped"
+#define WC_CAN_GEARBOX_STATUS_STATUS_BELOW_DRAG_NAME "StatusBelowDrag"
+#define WC_CAN_GEARBOX_STATUS_STATUS_SAFE_STATE_ACTIVE_NAME "StatusSafeStateActive"
+#define WC_CAN_GEARBOX_STATUS_STATUS_DEADLINE_MISS_NAME "StatusDeadlineMiss"
+#define WC_CAN_GEARBOX_STATUS_STATUS_OVER_TEMPERATURE_NAME "StatusOverTemperature"
+#define WC_CAN_GEARBOX_STATUS_STATUS_BENCH_INPUT_NAME "StatusBenchInput"
+#define WC_CAN_GEARBOX_STATUS_STATUS_FRAME_LOST_NAME "StatusFrameLost"
+#define WC_CAN_GEARBOX_STATUS_STATUS_BUS_ERROR_NAME "StatusBusError"
+#define WC_CAN_GEARBOX_STATUS_STATUS_LOCKED_NAME "StatusLocked"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_A_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_B_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_C_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_D_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_E_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_CRC_NAME "Crc"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ALIVE_COUNTER_NAME "AliveCounter"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_NAME "Role"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_LOCKED_NAME "Locked"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_VFS_CURRENT_NAME "VfsCurrent"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_PRESSURE_COMMAND_NAME "PressureCommand"
+#define WC_CAN_ELEMENT_F_VFS_COMMAND_ESTIMATED_TEMP_NAME "EstimatedTemp"
 #define WC_CAN_BENCH_MEASUREMENT_LOAD_CELL_FORCE_NAME "LoadCellForce"
 #define WC_CAN_BENCH_MEASUREMENT_MEASURED_TORQUE_NAME "MeasuredTorque"
 #define WC_CAN_BENCH_MEASUREMENT_CLUTCH_THERMISTOR_TEMP_NAME "ClutchThermistorTemp"
@@ -365,7 +559,7 @@ struct wc_can_torque_request_t {
 /**
  * Signals in message ShiftCommand.
  *
- * Shift command of the on-coming clutch (DESIGN 10), 1 ms. E2E protected, data id 0x12. Used while TorqueRequest.Mode is 3 (Shift).
+ * Shift command of the on-coming clutch (DESIGN 10), 1 ms. E2E protected, data id 0x12. Used while TorqueRequest.Mode is 3 (Shift); with the transmission (DESIGN 15) always, as its request input (the request timeout), with CurrentGear.
  *
  * All signal values are as on the CAN bus.
  */
@@ -407,7 +601,7 @@ struct wc_can_shift_command_t {
     uint8_t adaptation_reset;
 
     /**
-     * Target gear of the shift. Only 2 (the 1->2 upshift) is supported; another value aborts the shift (AbortReason 5).
+     * Target gear of the shift. The single-clutch shift controller (DESIGN 10, 14) supports only 2 (the 1->2 upshift); another value aborts the shift (AbortReason 5). The transmission (DESIGN 15) takes any gear of its box: a target it cannot reach from CurrentGear is refused with its reason (GearboxStatus.Refusal).
      *
      * Range: 1..8 (1..8 -)
      * Scale: 1
@@ -432,6 +626,15 @@ struct wc_can_shift_command_t {
      * Offset: 0
      */
     uint16_t target_inertia_time;
+
+    /**
+     * The gear the integrator believes engaged (0 reverse, 1..8 forward). Used only by the transmission (wc_loop with config.transmission, DESIGN 15): a shift request whose CurrentGear is not the gear the elements hold is refused (GearboxStatus.Refusal 6). Ignored by the single-clutch paths (sent as 0 by their logs).
+     *
+     * Range: 0..8 (0..8 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t current_gear;
 };
 
 /**
@@ -468,6 +671,69 @@ struct wc_can_offgoing_sensors_t {
      * Offset: 0
      */
     int16_t offgoing_slip_speed;
+};
+
+/**
+ * Signals in message GearboxSensors.
+ *
+ * Gearbox speed and temperature inputs of the transmission (DESIGN 15), 1 ms. E2E protected, data id 0x14. With the transmission (wc_loop config.transmission) this is the sensor input, with the sensor timeout, and the frame clock steps on it; ClutchSensors and TorqueRequest are then not received. Every element slip follows from the two speeds through the gearbox description (a w_t - b w_o).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_gearbox_sensors_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x14 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame (same rules as ClutchSensors).
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * Transmission oil temperature, scaling as ClutchSensors.OilTemp: 0.1 degC/bit, offset -50, valid -40..200 degC, raw 4095 = SNA.
+     *
+     * Range: 100..2500 (-40..200 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t oil_temp;
+
+    /**
+     * Turbine (gearbox input) speed, signed. 0.25 rpm/bit signed 16 bit, valid +-8000 rpm; raw -32768 = SNA.
+     *
+     * Range: -32000..32000 (-8000..8000 rpm)
+     * Scale: 0.25
+     * Offset: 0
+     */
+    int16_t turbine_speed;
+
+    /**
+     * Gearbox output speed, signed (< 0 rolling backwards). 0.25 rpm/bit signed 16 bit, valid +-8000 rpm; raw -32768 = SNA.
+     *
+     * Range: -32000..32000 (-8000..8000 rpm)
+     * Scale: 0.25
+     * Offset: 0
+     */
+    int16_t output_speed;
+
+    /**
+     * Gearbox housing temperature (the elements' heat sink, eq. 1). 1 degC/bit, offset -50, 8 bit: valid -40..200 degC, raw 255 = SNA.
+     *
+     * Range: 10..250 (-40..200 degC)
+     * Scale: 1
+     * Offset: -50
+     */
+    uint8_t housing_temp;
 };
 
 /**
@@ -990,6 +1256,645 @@ struct wc_can_engine_torque_request_t {
      * Offset: 0
      */
     int16_t torque_delta;
+};
+
+/**
+ * Signals in message GearboxStatus.
+ *
+ * Transmission status (DESIGN 15), sent by the TCU every 1 ms step with the transmission, after the element commands. E2E protected, data id 0x26. The status word has the bits and meanings of VfsCommand's (the loop's one status word; StatusLocked: every closed element locked, StatusBenchInput never).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_gearbox_status_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x26 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * The gear the elements hold (0 reverse, 1..8), or the running shift's source gear.
+     *
+     * Range: 0..8 (0..8 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t gear;
+
+    /**
+     * The running shift's target gear; the held gear when no shift runs.
+     *
+     * Range: 0..8 (0..8 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t target_gear;
+
+    /**
+     * The running shift's phase, as OffgoingVfsCommand.ShiftPhase: 0 idle (in a gear), 1 prepare, 2 torque, 3 inertia, 4 lock-up, 5 locked, 6 aborted.
+     *
+     * Range: 0..6 (0..6 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t shift_phase;
+
+    /**
+     * The type of the running or last shift (DESIGN 15): 0 power-on upshift, 1 power-off upshift (tip-out), 2 power-on downshift (kickdown), 3 power-off downshift (coast).
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t shift_type;
+
+    /**
+     * Why the last request's rising edge started no shift (include/wetclutch/wc_gearbox.h): 0 accepted, 1 same gear, 2 no such gear, 3 a swap of two elements, 4 to or from reverse, 5 not in the table, 6 CurrentGear is not the held gear, 7 busy (a shift runs or the safe state), 8 no model for this shift.
+     *
+     * Range: 0..8 (0..8 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t refusal;
+
+    /**
+     * As VfsCommand.StatusSensorTimeout.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_sensor_timeout;
+
+    /**
+     * As VfsCommand.StatusRequestTimeout.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_request_timeout;
+
+    /**
+     * As VfsCommand.StatusCrcError.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_crc_error;
+
+    /**
+     * As VfsCommand.StatusCounterError.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_counter_error;
+
+    /**
+     * As VfsCommand.StatusImplausibleInput.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_implausible_input;
+
+    /**
+     * As VfsCommand.StatusSaturated.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_saturated;
+
+    /**
+     * As VfsCommand.StatusCurrentClamped.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_current_clamped;
+
+    /**
+     * As VfsCommand.StatusBelowDrag.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_below_drag;
+
+    /**
+     * As VfsCommand.StatusSafeStateActive.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_safe_state_active;
+
+    /**
+     * As VfsCommand.StatusDeadlineMiss.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_deadline_miss;
+
+    /**
+     * As VfsCommand.StatusOverTemperature.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_over_temperature;
+
+    /**
+     * As VfsCommand.StatusBenchInput.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_bench_input;
+
+    /**
+     * As VfsCommand.StatusFrameLost.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_frame_lost;
+
+    /**
+     * As VfsCommand.StatusBusError.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_bus_error;
+
+    /**
+     * As VfsCommand.StatusLocked.
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t status_locked;
+};
+
+/**
+ * Signals in message ElementAVfsCommand.
+ *
+ * VFS command of shift element A (element 0 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x28. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_a_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x28 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
+};
+
+/**
+ * Signals in message ElementBVfsCommand.
+ *
+ * VFS command of shift element B (element 1 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x29. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_b_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x29 then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
+};
+
+/**
+ * Signals in message ElementCVfsCommand.
+ *
+ * VFS command of shift element C (element 2 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x2A. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_c_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x2A then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
+};
+
+/**
+ * Signals in message ElementDVfsCommand.
+ *
+ * VFS command of shift element D (element 3 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x2B. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_d_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x2B then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
+};
+
+/**
+ * Signals in message ElementEVfsCommand.
+ *
+ * VFS command of shift element E (element 4 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x2C. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_e_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x2C then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
+};
+
+/**
+ * Signals in message ElementFVfsCommand.
+ *
+ * VFS command of shift element F (element 5 of the gearbox description; DESIGN 15), sent by the TCU every 1 ms step with the transmission, for each element the gearbox has, in element order. E2E protected, data id 0x2D. The six element frames have one layout (tests/python/test_dbc.py checks it).
+ *
+ * All signal values are as on the CAN bus.
+ */
+struct wc_can_element_f_vfs_command_t {
+    /**
+     * CRC-8 SAE J1850 over data id 0x2D then bytes 1..7.
+     *
+     * Range: 0..255 (0..255 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t crc;
+
+    /**
+     * Alive counter, +1 mod 16 per frame.
+     *
+     * Range: 0..15 (0..15 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t alive_counter;
+
+    /**
+     * 0 open; 1 held (closed in the gear, or kept closed by the running shift); 2 the running shift's on-coming element; 3 its off-going element.
+     *
+     * Range: 0..3 (0..3 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t role;
+
+    /**
+     * 1: the element's model says it is locked (static friction holds it, DESIGN 9).
+     *
+     * Range: 0..1 (0..1 -)
+     * Scale: 1
+     * Offset: 0
+     */
+    uint8_t locked;
+
+    /**
+     * Commanded VFS current of the element, scaling as VfsCommand.VfsCurrent (NaN sent as 0 mA).
+     *
+     * Range: 0..64000 (0..2000 mA)
+     * Scale: 0.03125
+     * Offset: 0
+     */
+    uint16_t vfs_current;
+
+    /**
+     * Piston pressure the command aims at, scaling as VfsCommand.PressureCommand.
+     *
+     * Range: 0..64000 (0..4000 kPa)
+     * Scale: 0.0625
+     * Offset: 0
+     */
+    uint16_t pressure_command;
+
+    /**
+     * The element's friction-surface temperature from its observer (eq. 1), scaling as ClutchEstimate.EstimatedClutchTemp; raw 4095 = SNA.
+     *
+     * Range: 100..4000 (-40..350 degC)
+     * Scale: 0.1
+     * Offset: -50
+     */
+    uint16_t estimated_temp;
 };
 
 /**
@@ -1582,6 +2487,28 @@ bool wc_can_shift_command_target_inertia_time_is_in_range(uint16_t value);
 bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value);
 
 /**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_current_gear_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_shift_command_current_gear_is_in_phys_range(float value);
+
+/**
  * Pack message OffgoingSensors.
  *
  * @param[out] dst_p Buffer to pack the message into.
@@ -1683,6 +2610,175 @@ bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_range(int16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_phys_range(float value);
+
+/**
+ * Pack message GearboxSensors.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_gearbox_sensors_pack(
+    uint8_t *dst_p,
+    const struct wc_can_gearbox_sensors_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message GearboxSensors.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_gearbox_sensors_unpack(
+    struct wc_can_gearbox_sensors_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from GearboxSensors.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_gearbox_sensors_init(struct wc_can_gearbox_sensors_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_oil_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_oil_temp_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_turbine_speed_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_turbine_speed_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_output_speed_is_in_range(int16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_output_speed_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_housing_temp_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_sensors_housing_temp_is_in_phys_range(float value);
 
 /**
  * Pack message VfsCommand.
@@ -3049,6 +4145,1673 @@ bool wc_can_engine_torque_request_torque_delta_is_in_range(int16_t value);
  * @return true if in range, false otherwise.
  */
 bool wc_can_engine_torque_request_torque_delta_is_in_phys_range(float value);
+
+/**
+ * Pack message GearboxStatus.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_gearbox_status_pack(
+    uint8_t *dst_p,
+    const struct wc_can_gearbox_status_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message GearboxStatus.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_gearbox_status_unpack(
+    struct wc_can_gearbox_status_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from GearboxStatus.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_gearbox_status_init(struct wc_can_gearbox_status_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_gear_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_gear_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_target_gear_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_target_gear_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_shift_phase_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_shift_phase_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_shift_type_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_shift_type_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_refusal_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_refusal_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_sensor_timeout_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_sensor_timeout_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_request_timeout_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_request_timeout_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_crc_error_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_crc_error_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_counter_error_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_counter_error_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_implausible_input_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_implausible_input_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_saturated_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_saturated_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_current_clamped_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_current_clamped_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_below_drag_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_below_drag_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_safe_state_active_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_safe_state_active_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_deadline_miss_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_deadline_miss_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_over_temperature_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_over_temperature_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_bench_input_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_bench_input_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_frame_lost_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_frame_lost_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_bus_error_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_bus_error_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_gearbox_status_status_locked_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementAVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_a_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_a_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementAVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_a_vfs_command_unpack(
+    struct wc_can_element_a_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementAVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_a_vfs_command_init(struct wc_can_element_a_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_a_vfs_command_estimated_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementBVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_b_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_b_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementBVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_b_vfs_command_unpack(
+    struct wc_can_element_b_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementBVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_b_vfs_command_init(struct wc_can_element_b_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_b_vfs_command_estimated_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementCVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_c_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_c_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementCVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_c_vfs_command_unpack(
+    struct wc_can_element_c_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementCVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_c_vfs_command_init(struct wc_can_element_c_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_c_vfs_command_estimated_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementDVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_d_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_d_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementDVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_d_vfs_command_unpack(
+    struct wc_can_element_d_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementDVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_d_vfs_command_init(struct wc_can_element_d_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_d_vfs_command_estimated_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementEVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_e_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_e_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementEVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_e_vfs_command_unpack(
+    struct wc_can_element_e_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementEVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_e_vfs_command_init(struct wc_can_element_e_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_e_vfs_command_estimated_temp_is_in_phys_range(float value);
+
+/**
+ * Pack message ElementFVfsCommand.
+ *
+ * @param[out] dst_p Buffer to pack the message into.
+ * @param[in] src_p Data to pack.
+ * @param[in] size Size of dst_p.
+ *
+ * @return Size of packed data, or negative error code.
+ */
+int wc_can_element_f_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_f_vfs_command_t *src_p,
+    size_t size);
+
+/**
+ * Unpack message ElementFVfsCommand.
+ *
+ * @param[out] dst_p Object to unpack the message into.
+ * @param[in] src_p Message to unpack.
+ * @param[in] size Size of src_p.
+ *
+ * @return zero(0) or negative error code.
+ */
+int wc_can_element_f_vfs_command_unpack(
+    struct wc_can_element_f_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size);
+
+/**
+ * Init message fields to default values from ElementFVfsCommand.
+ *
+ * @param[in] msg_p Message to init.
+ *
+ * @return zero(0) on success or (-1) in case of nullptr argument.
+ */
+int wc_can_element_f_vfs_command_init(struct wc_can_element_f_vfs_command_t *msg_p);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_crc_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_crc_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_alive_counter_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_alive_counter_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_role_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_role_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_locked_is_in_range(uint8_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_locked_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_vfs_current_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_vfs_current_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_pressure_command_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_pressure_command_is_in_phys_range(float value);
+
+/**
+ * Check that given signal is in allowed range.
+ *
+ * @param[in] value Signal to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_estimated_temp_is_in_range(uint16_t value);
+
+/**
+ * Check that given physical value is in allowed range before encoding.
+ *
+ * Use this BEFORE calling _encode() to avoid silent integer overflow:
+ *   encode(-1.0) on a [0,100] signal wraps to 255 and passes is_in_range().
+ *   is_in_phys_range(-1.0) correctly returns false.
+ *
+ * @param[in] value Physical signal value to check.
+ *
+ * @return true if in range, false otherwise.
+ */
+bool wc_can_element_f_vfs_command_estimated_temp_is_in_phys_range(float value);
 
 /**
  * Pack message BenchMeasurement.

@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-/* VfsCommand status word: bit n is the n-th Status* signal of the DBC. */
+/* The status word (VfsCommand, GearboxStatus): bit n is the n-th Status* signal of the DBC. */
 #define WC_CAN_STATUS_SENSOR_TIMEOUT (1u << 0)
 #define WC_CAN_STATUS_REQUEST_TIMEOUT (1u << 1)
 #define WC_CAN_STATUS_CRC_ERROR (1u << 2)
@@ -44,7 +44,12 @@ extern const wc_can_signal_t wc_can_sig_shift_command_adaptation_reset; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_gear; /* 1 */
 extern const wc_can_signal_t wc_can_sig_shift_command_turbine_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time; /* ms */
+extern const wc_can_signal_t wc_can_sig_shift_command_current_gear; /* 1 */
 extern const wc_can_signal_t wc_can_sig_offgoing_sensors_offgoing_slip_speed; /* rpm */
+extern const wc_can_signal_t wc_can_sig_gearbox_sensors_oil_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_gearbox_sensors_turbine_speed; /* rpm */
+extern const wc_can_signal_t wc_can_sig_gearbox_sensors_output_speed; /* rpm */
+extern const wc_can_signal_t wc_can_sig_gearbox_sensors_housing_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_vfs_command_vfs_current; /* mA */
 extern const wc_can_signal_t wc_can_sig_vfs_command_pressure_command; /* kPa */
 extern const wc_can_signal_t wc_can_sig_clutch_estimate_estimated_clutch_temp; /* degC */
@@ -73,6 +78,27 @@ extern const wc_can_signal_t wc_can_sig_offgoing_vfs_command_vfs_current; /* mA 
 extern const wc_can_signal_t wc_can_sig_offgoing_vfs_command_pressure_command; /* kPa */
 extern const wc_can_signal_t wc_can_sig_engine_torque_request_intervention_active; /* 1 */
 extern const wc_can_signal_t wc_can_sig_engine_torque_request_torque_delta; /* Nm */
+extern const wc_can_signal_t wc_can_sig_gearbox_status_gear; /* 1 */
+extern const wc_can_signal_t wc_can_sig_gearbox_status_target_gear; /* 1 */
+extern const wc_can_signal_t wc_can_sig_gearbox_status_shift_phase; /* 1 */
+extern const wc_can_signal_t wc_can_sig_element_a_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_a_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_a_vfs_command_estimated_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_element_b_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_b_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_b_vfs_command_estimated_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_element_c_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_c_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_c_vfs_command_estimated_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_element_d_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_d_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_d_vfs_command_estimated_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_element_e_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_e_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_e_vfs_command_estimated_temp; /* degC */
+extern const wc_can_signal_t wc_can_sig_element_f_vfs_command_vfs_current; /* mA */
+extern const wc_can_signal_t wc_can_sig_element_f_vfs_command_pressure_command; /* kPa */
+extern const wc_can_signal_t wc_can_sig_element_f_vfs_command_estimated_temp; /* degC */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force; /* N */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_measured_torque; /* Nm */
 extern const wc_can_signal_t wc_can_sig_bench_measurement_clutch_thermistor_temp; /* degC */
@@ -104,6 +130,7 @@ typedef struct {
     float target_gear;
     float turbine_torque_Nm;
     float target_inertia_time_ms;
+    float current_gear;
     uint8_t alive_counter;
 } wc_can_shift_command_phys_t;
 
@@ -112,6 +139,15 @@ typedef struct {
     float offgoing_slip_speed_rpm;
     uint8_t alive_counter;
 } wc_can_offgoing_sensors_phys_t;
+
+/** GearboxSensors (0x114) in physical units. */
+typedef struct {
+    float oil_temp_degC;
+    float turbine_speed_rpm;
+    float output_speed_rpm;
+    float housing_temp_degC;
+    uint8_t alive_counter;
+} wc_can_gearbox_sensors_phys_t;
 
 /** VfsCommand (0x120) in physical units. */
 typedef struct {
@@ -172,6 +208,77 @@ typedef struct {
     uint8_t alive_counter;
 } wc_can_engine_torque_request_phys_t;
 
+/** GearboxStatus (0x126) in physical units. */
+typedef struct {
+    float gear;
+    float target_gear;
+    float shift_phase;
+    uint8_t shift_type; /**< WC_CAN_GEARBOX_STATUS_SHIFT_TYPE_*_CHOICE */
+    uint8_t refusal; /**< WC_CAN_GEARBOX_STATUS_REFUSAL_*_CHOICE */
+    uint16_t status; /**< WC_CAN_STATUS_* bits */
+    uint8_t alive_counter;
+} wc_can_gearbox_status_phys_t;
+
+/** ElementAVfsCommand (0x128) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_A_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_A_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_a_vfs_command_phys_t;
+
+/** ElementBVfsCommand (0x129) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_B_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_B_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_b_vfs_command_phys_t;
+
+/** ElementCVfsCommand (0x12A) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_C_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_C_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_c_vfs_command_phys_t;
+
+/** ElementDVfsCommand (0x12B) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_D_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_D_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_d_vfs_command_phys_t;
+
+/** ElementEVfsCommand (0x12C) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_E_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_E_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_e_vfs_command_phys_t;
+
+/** ElementFVfsCommand (0x12D) in physical units. */
+typedef struct {
+    float vfs_current_mA;
+    float pressure_command_kPa;
+    float estimated_temp_degC;
+    uint8_t role; /**< WC_CAN_ELEMENT_F_VFS_COMMAND_ROLE_*_CHOICE */
+    uint8_t locked; /**< WC_CAN_ELEMENT_F_VFS_COMMAND_LOCKED_*_CHOICE */
+    uint8_t alive_counter;
+} wc_can_element_f_vfs_command_phys_t;
+
 /** BenchMeasurement (0x130) in physical units. */
 typedef struct {
     float load_cell_force_N;
@@ -216,6 +323,8 @@ wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_com
 wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_offgoing_sensors(uint8_t *dst, const wc_can_offgoing_sensors_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_offgoing_sensors(wc_can_offgoing_sensors_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_gearbox_sensors(uint8_t *dst, const wc_can_gearbox_sensors_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_gearbox_sensors(wc_can_gearbox_sensors_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_vfs_command(uint8_t *dst, const wc_can_vfs_command_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_vfs_command(wc_can_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_clutch_estimate(uint8_t *dst, const wc_can_clutch_estimate_phys_t *src, size_t size);
@@ -228,6 +337,20 @@ wc_can_result_t wc_can_encode_offgoing_vfs_command(uint8_t *dst, const wc_can_of
 wc_can_result_t wc_can_decode_offgoing_vfs_command(wc_can_offgoing_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_engine_torque_request(uint8_t *dst, const wc_can_engine_torque_request_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_engine_torque_request(wc_can_engine_torque_request_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_gearbox_status(uint8_t *dst, const wc_can_gearbox_status_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_gearbox_status(wc_can_gearbox_status_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_a_vfs_command(uint8_t *dst, const wc_can_element_a_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_a_vfs_command(wc_can_element_a_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_b_vfs_command(uint8_t *dst, const wc_can_element_b_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_b_vfs_command(wc_can_element_b_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_c_vfs_command(uint8_t *dst, const wc_can_element_c_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_c_vfs_command(wc_can_element_c_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_d_vfs_command(uint8_t *dst, const wc_can_element_d_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_d_vfs_command(wc_can_element_d_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_e_vfs_command(uint8_t *dst, const wc_can_element_e_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_e_vfs_command(wc_can_element_e_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
+wc_can_result_t wc_can_encode_element_f_vfs_command(uint8_t *dst, const wc_can_element_f_vfs_command_phys_t *src, size_t size);
+wc_can_result_t wc_can_decode_element_f_vfs_command(wc_can_element_f_vfs_command_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_bench_measurement(uint8_t *dst, const wc_can_bench_measurement_phys_t *src, size_t size);
 wc_can_result_t wc_can_decode_bench_measurement(wc_can_bench_measurement_phys_t *dst, const uint8_t *src, size_t size);
 wc_can_result_t wc_can_encode_xcp_command(uint8_t *dst, const wc_can_xcp_command_phys_t *src, size_t size);

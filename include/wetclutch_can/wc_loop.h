@@ -1,6 +1,7 @@
-/* The CAN frame loop of one clutch: portable (no OS calls), fixed-size
- * receive ring, E2E checks, input freshness, one model step per period and
- * the two output frames. The frames and their scaling are those of
+/* The CAN frame loop of one clutch (its whole shift: two clutches), or of a
+ * gearbox's shift elements (the transmission, DESIGN 15): portable (no OS
+ * calls), fixed-size receive ring, E2E checks, input freshness, one model
+ * step per period and the cyclic output frames. The frames and their scaling are those of
  * hil/wetclutch.dbc (generated codec: wc_can.h, wc_can_signals.h).
  *
  * Who may call what, from where (one wc_loop_t per clutch, no shared state
@@ -49,6 +50,14 @@
  *    (OffgoingVfsCommand.Fallback says which; wc_shift.h). The observer keeps
  *    running on the held temperatures. An input that comes and goes
  *    therefore holds the safe state instead of switching the solenoid.
+ *  - With the transmission (config.transmission, DESIGN 15) the control
+ *    inputs are GearboxSensors (turbine and output speed, oil and housing
+ *    temperature; the sensor timeout, StatusSensorTimeout) and ShiftCommand
+ *    (with CurrentGear; the request timeout, StatusRequestTimeout);
+ *    ClutchSensors, TorqueRequest and OffgoingSensors are unknown ids. Its
+ *    safe state holds the gear: every closed element at its maximum current
+ *    (wc_transmission.h), a running shift takes its phase's fallback, no
+ *    engine request, no new shift (GearboxStatus.Refusal 7).
  *  - Before the inputs have been fresh for recovery_periods after init, the
  *    loop is in the safe state.
  *  - BenchMeasurement (bench only, no E2E) is used only when
@@ -71,12 +80,15 @@
 #include "wc_can_signals.h"
 #include <wetclutch/wc_clutch.h>
 #include <wetclutch/wc_shift.h>
+#include <wetclutch/wc_transmission.h>
 #include "wc_e2e.h"
 
 #define WC_LOOP_RX_CAPACITY 32u   /* frames buffered between two steps */
 #define WC_LOOP_TX_CYCLIC 2u      /* every step: VfsCommand, ClutchEstimate */
 #define WC_LOOP_TX_WHOLE_SHIFT 2u /* every step too with the whole shift (DESIGN 14): OffgoingVfsCommand, EngineTorqueRequest */
-#define WC_LOOP_TX_FRAMES 6u      /* at most: ... then ShiftReport and AdaptationReport in the step a shift ends */
+#define WC_LOOP_TX_GEARBOX_CYCLIC (WC_GEARBOX_ELEMENTS_MAX + 2u) /* with the transmission, every step: one
+                                  * ElementXVfsCommand per element, GearboxStatus, EngineTorqueRequest */
+#define WC_LOOP_TX_FRAMES 9u      /* at most: ... then ShiftReport (and AdaptationReport) in the step a shift ends */
 
 typedef struct {
     uint32_t sensor_timeout_periods;   /* ClutchSensors freshness limit (default 10) */
@@ -99,14 +111,26 @@ typedef struct {
      * mode, with the sensor timeout) and sends OffgoingVfsCommand and
      * EngineTorqueRequest every step after ClutchEstimate. */
     const wc_calibration_t *offgoing;
+    /* The transmission (DESIGN 15): a gearbox's shift elements instead of one
+     * clutch (checked at init by wc_transmission_init; shift, offgoing and
+     * the bench input must then be off: the transmission has its own shift
+     * calibration). NULL: one clutch. It starts holding transmission_start_gear. */
+    const wc_transmission_config_t *transmission;
+    uint32_t transmission_start_gear;
 } wc_loop_config_t;
 
-#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL, NULL, NULL, NULL }
+#define WC_LOOP_CONFIG_DEFAULT { 10u, 10u, { 2u, 3u }, 20u, false, NULL, NULL, NULL, NULL, NULL, 1u }
 
 /* The whole shift runs (DESIGN 14): a shift calibration with the coordinator and the off-going clutch's calibration. */
 static inline bool wc_loop_whole_shift(const wc_loop_config_t *config)
 {
     return (config->shift != NULL) && (config->shift->coordinator == 1u) && (config->offgoing != NULL);
+}
+
+/* The loop runs a gearbox's shift elements (DESIGN 15). */
+static inline bool wc_loop_gearbox(const wc_loop_config_t *config)
+{
+    return config->transmission != NULL;
 }
 
 typedef enum {
@@ -179,10 +203,23 @@ typedef struct {
     uint8_t tx_alive_offgoing;
     uint8_t tx_alive_engine;
     bool adaptation_reset_requested;        /* wc_loop_request_adaptation_reset: taken at the next step */
+    /* The transmission (DESIGN 15; config.transmission) */
+    wc_loop_input_t gearbox_in;             /* GearboxSensors */
+    wc_can_gearbox_sensors_phys_t gearbox_sensors;  /* last valid */
+    wc_transmission_t transmission;
+    wc_transmission_command_t transmission_command;  /* this step's, from ShiftCommand */
+    wc_transmission_input_t transmission_input;      /* this step's, from GearboxSensors */
+    wc_transmission_output_t transmission_out;       /* the last step's (the controllers read it back) */
+    uint8_t tx_alive_element[WC_GEARBOX_ELEMENTS_MAX];
+    uint8_t tx_alive_status;
 } wc_loop_t;
 
 /* Validate the calibration (and the shift calibration: a failing one returns
- * WC_CAL_NULL) and start in the safe state (no input seen). */
+ * WC_CAL_NULL) and start in the safe state (no input seen). With the
+ * transmission cal is not used (may be NULL: each element has its own in
+ * config.transmission); a transmission that wc_transmission_init refuses
+ * (it says why), or one beside a shift, off-going or bench configuration,
+ * returns WC_CAL_NULL. */
 wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config,
                             float theta_start_degC);
 
@@ -197,7 +234,8 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
  * the shift control's presence are the port's (its timer, its receive
  * filter): the caller keeps them (wc_xcp refuses a page that changes
  * them). Both objects must outlive their use, as at init. Same context as
- * wc_loop_step, never beside it. */
+ * wc_loop_step, never beside it. A loop with the transmission (either
+ * side) refuses with WC_CAL_NULL: its online calibration is not there yet. */
 wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal, const wc_loop_config_t *config);
 
 /* Load the clutch's learned values from an adaptation image (wc_adapt_image.h)
@@ -259,24 +297,27 @@ void wc_loop_shift_report_frame(const wc_shift_report_t *q, wc_can_frame_t *out)
 /* When a port's main loop steps the model. */
 typedef enum {
     WC_LOOP_CLOCK_TIMER = 0,  /* a fixed period: the port passes tick = true at each deadline */
-    WC_LOOP_CLOCK_FRAME = 1   /* one step per received ClutchSensors data frame (deterministic replay) */
+    WC_LOOP_CLOCK_FRAME = 1   /* one step per received ClutchSensors data frame (with the transmission:
+                               * GearboxSensors; deterministic replay) */
 } wc_loop_clock_t;
 
 /* The work of one iteration of a port's main loop, the same for every port
  * (wc_tcu on SocketCAN, the loop tests with a mocked port): queue frame (NULL
  * when the port's wait ended without one), then step when the clock says so:
- * tick, or with WC_LOOP_CLOCK_FRAME a ClutchSensors data frame. Returns the
+ * tick, or with WC_LOOP_CLOCK_FRAME a ClutchSensors (transmission: GearboxSensors) data frame. Returns the
  * number of frames written to out for the port to transmit (0 when no step). */
 uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_frame_t *frame, bool tick,
                          wc_can_frame_t out[WC_LOOP_TX_FRAMES]);
 
 /* All ids the loop can receive: the control frames, ShiftCommand (used only
- * with config.shift), OffgoingSensors (only with the whole shift),
- * BenchMeasurement (only with bench_input_enabled). */
+ * with config.shift or the transmission), OffgoingSensors (only with the
+ * whole shift), BenchMeasurement (only with bench_input_enabled),
+ * GearboxSensors (only with the transmission, which takes only it and
+ * ShiftCommand). */
 #define WC_LOOP_RX_IDS { WC_CAN_CLUTCH_SENSORS_FRAME_ID, WC_CAN_TORQUE_REQUEST_FRAME_ID, \
                          WC_CAN_SHIFT_COMMAND_FRAME_ID, WC_CAN_OFFGOING_SENSORS_FRAME_ID, \
-                         WC_CAN_BENCH_MEASUREMENT_FRAME_ID }
-#define WC_LOOP_RX_ID_COUNT 5u
+                         WC_CAN_BENCH_MEASUREMENT_FRAME_ID, WC_CAN_GEARBOX_SENSORS_FRAME_ID }
+#define WC_LOOP_RX_ID_COUNT 6u
 
 /* The receive filter of a port for this configuration: writes the ids the
  * loop uses (of WC_LOOP_RX_IDS) to ids and returns their count; a port

@@ -5,11 +5,13 @@
 #include <string.h>
 
 #include "wetclutch/wetclutch.h"
+#include "wc_loop_internal.h"
 
 /* Sizes the loop relies on. */
 WC_STATIC_ASSERT((WC_LOOP_RX_CAPACITY & (WC_LOOP_RX_CAPACITY - 1u)) == 0u, rx_ring_is_a_power_of_two);
 WC_STATIC_ASSERT(WC_LOOP_RX_CAPACITY >= 2u * WC_LOOP_RX_ID_COUNT, rx_ring_holds_two_periods_of_input);
-WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES == WC_LOOP_TX_CYCLIC + WC_LOOP_TX_WHOLE_SHIFT + 2u), tx_is_command_estimate_whole_shift_and_reports);
+WC_STATIC_ASSERT((WC_LOOP_TX_CYCLIC == 2u) && (WC_LOOP_TX_FRAMES >= WC_LOOP_TX_CYCLIC + WC_LOOP_TX_WHOLE_SHIFT + 2u) &&
+                 (WC_LOOP_TX_FRAMES >= WC_LOOP_TX_GEARBOX_CYCLIC + 1u), tx_holds_the_cyclic_frames_and_the_reports);
 WC_STATIC_ASSERT(WC_CAN_ADAPTATION_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), adaptation_report_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, shift_command_is_an_e2e_frame);
 WC_STATIC_ASSERT(WC_CAN_SHIFT_REPORT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), shift_report_fits_a_frame);
@@ -19,14 +21,6 @@ WC_STATIC_ASSERT(WC_CAN_VFS_COMMAND_LENGTH == WC_E2E_FRAME_BYTES, vfs_command_is
 WC_STATIC_ASSERT(WC_CAN_CLUTCH_ESTIMATE_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), clutch_estimate_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_BENCH_MEASUREMENT_LENGTH <= sizeof(((wc_can_frame_t *)0)->data), bench_fits_a_frame);
 WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_word_is_16_bits);
-
-static void input_reset(wc_loop_input_t *in)
-{
-    in->age_periods = 0u;
-    in->seen = false;
-    in->stale = true;
-    wc_e2e_receiver_init(&in->e2e);
-}
 
 /* The shift part of a configuration: a shift calibration that passes its
  * check (which says which field fails), and with the whole shift (DESIGN 14)
@@ -44,6 +38,7 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     WC_ASSERT((loop != NULL) && (config != NULL));
     if ((loop == NULL) || (config == NULL)) { return WC_CAL_NULL; }
     memset(loop, 0, sizeof *loop);
+    if (wc_loop_gearbox(config)) { return wc_loop_gearbox_init(loop, config, theta_start_degC); }
     if (!shift_config_usable(config)) { return WC_CAL_NULL; }
     const wc_cal_error_t error = wc_clutch_init(&loop->clutch, cal, theta_start_degC);
     if (error != WC_CAL_OK) { return error; }
@@ -58,11 +53,11 @@ wc_cal_error_t wc_loop_init(wc_loop_t *loop, const wc_calibration_t *cal, const 
     wc_adapt_reset(&loop->adapt);
     loop->adapt.status = WC_ADAPT_STATUS_IMAGE_MISSING;  /* until wc_loop_load_adaptation */
     loop->config = *config;
-    input_reset(&loop->sensors_in);
-    input_reset(&loop->request_in);
-    input_reset(&loop->bench_in);
-    input_reset(&loop->shift_in);
-    input_reset(&loop->offgoing_in);
+    wc_loop_input_reset(&loop->sensors_in);
+    wc_loop_input_reset(&loop->request_in);
+    wc_loop_input_reset(&loop->bench_in);
+    wc_loop_input_reset(&loop->shift_in);
+    wc_loop_input_reset(&loop->offgoing_in);
     loop->sensors.oil_temp_degC = theta_start_degC;
     loop->sensors.housing_temp_degC = theta_start_degC;
     loop->request.mode = WC_CAN_TORQUE_REQUEST_MODE_OPEN_CHOICE;
@@ -73,6 +68,7 @@ wc_cal_error_t wc_loop_recalibrate(wc_loop_t *loop, const wc_calibration_t *cal,
 {
     WC_ASSERT((loop != NULL) && (cal != NULL) && (config != NULL));
     if ((loop == NULL) || (cal == NULL) || (config == NULL)) { return WC_CAL_NULL; }
+    if (wc_loop_gearbox(config) || wc_loop_gearbox(&loop->config)) { return WC_CAL_NULL; }  /* not online yet */
     if (!shift_config_usable(config)) { return WC_CAL_NULL; }
     /* the whole shift cannot be switched on or off online */
     if (wc_loop_whole_shift(config) != wc_loop_whole_shift(&loop->config)) { return WC_CAL_NULL; }
@@ -206,25 +202,30 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
         reject(loop, WC_REJECT_FORMAT);
         return;
     }
-    if (f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) {
+    const bool gearbox = wc_loop_gearbox(&loop->config);
+    if ((f->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && !gearbox) {
         wc_can_clutch_sensors_phys_t s = {0.0f, 0.0f, 0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_clutch_sensors(&s, f->data, f->dlc);
         if (accept(loop, &loop->sensors_in, r, true, s.alive_counter)) { loop->sensors = s; }
-    } else if (f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID) {
+    } else if ((f->id == WC_CAN_TORQUE_REQUEST_FRAME_ID) && !gearbox) {
         wc_can_torque_request_phys_t q = {0.0f, 0u, 0u};
         wc_can_result_t r = wc_can_decode_torque_request(&q, f->data, f->dlc);
         if ((q.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE) && (loop->config.shift == NULL) && (r < WC_CAN_ERR_NAN)) {
             r = WC_CAN_ERR_RANGE;  /* no shift controller configured: Mode 3 is not a mode here */
         }
         if (accept(loop, &loop->request_in, r, true, q.alive_counter)) { loop->request = q; }
-    } else if ((f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID) && (loop->config.shift != NULL)) {
-        wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u};
+    } else if ((f->id == WC_CAN_SHIFT_COMMAND_FRAME_ID) && ((loop->config.shift != NULL) || gearbox)) {
+        wc_can_shift_command_phys_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_shift_command(&c, f->data, f->dlc);
         if (accept(loop, &loop->shift_in, r, true, c.alive_counter)) { loop->shift_command = c; }
     } else if ((f->id == WC_CAN_OFFGOING_SENSORS_FRAME_ID) && wc_loop_whole_shift(&loop->config)) {
         wc_can_offgoing_sensors_phys_t o = {0.0f, 0u};
         const wc_can_result_t r = wc_can_decode_offgoing_sensors(&o, f->data, f->dlc);
         if (accept(loop, &loop->offgoing_in, r, true, o.alive_counter)) { loop->offgoing_sensors = o; }
+    } else if ((f->id == WC_CAN_GEARBOX_SENSORS_FRAME_ID) && gearbox) {
+        wc_can_gearbox_sensors_phys_t g = {0.0f, 0.0f, 0.0f, 0.0f, 0u};
+        const wc_can_result_t r = wc_can_decode_gearbox_sensors(&g, f->data, f->dlc);
+        if (accept(loop, &loop->gearbox_in, r, true, g.alive_counter)) { loop->gearbox_sensors = g; }
     } else if ((f->id == WC_CAN_BENCH_MEASUREMENT_FRAME_ID) && loop->config.bench_input_enabled) {
         wc_can_bench_measurement_phys_t b = {0.0f, 0.0f, 0.0f};
         const wc_can_result_t r = wc_can_decode_bench_measurement(&b, f->data, f->dlc);
@@ -232,20 +233,6 @@ static WC_NOINLINE void process(wc_loop_t *loop, const wc_can_frame_t *f)
     } else {
         reject(loop, WC_REJECT_UNKNOWN_ID);
     }
-}
-
-/* Freshness after this period's frames; returns true when stale. */
-static bool update_freshness(wc_loop_input_t *in, uint32_t timeout_periods, uint32_t *timeouts)
-{
-    const bool stale = !in->seen || (in->age_periods >= timeout_periods);
-    if (stale && !in->stale && in->seen) {
-        (*timeouts)++;
-        in->seen = false;
-        wc_e2e_receiver_restart(&in->e2e);  /* the input must prove itself: reference + SyncCounter frames */
-    }
-    in->stale = stale;
-    if (in->age_periods < UINT32_MAX) { in->age_periods++; }
-    return stale;
 }
 
 /* One numbering for the mode: the C enum has the DBC's values. */
@@ -257,34 +244,6 @@ WC_STATIC_ASSERT(WC_MODE_LOCKED == WC_CAN_TORQUE_REQUEST_MODE_LOCKED_CHOICE, mod
 static wc_clutch_mode_t mode_of(uint8_t can_mode)
 {
     return (can_mode <= (uint8_t)WC_MODE_LOCKED) ? (wc_clutch_mode_t)can_mode : WC_MODE_OPEN;
-}
-
-/* Model status bit -> VfsCommand status bit. */
-typedef struct {
-    wc_status_t model;
-    uint16_t can;
-} wc_status_map_t;
-
-static const wc_status_map_t status_map[] = {
-    { WC_STATUS_SATURATED, WC_CAN_STATUS_SATURATED },
-    { WC_STATUS_CURRENT_CLAMPED, WC_CAN_STATUS_CURRENT_CLAMPED },
-    { WC_STATUS_BELOW_DRAG, WC_CAN_STATUS_BELOW_DRAG },
-    { WC_STATUS_INPUT_INVALID, WC_CAN_STATUS_IMPLAUSIBLE_INPUT },
-    { WC_STATUS_OVER_TEMPERATURE, WC_CAN_STATUS_OVER_TEMPERATURE },
-    { WC_STATUS_NOT_INITIALISED, WC_CAN_STATUS_SAFE_STATE_ACTIVE },
-    { WC_STATUS_LOCKED, WC_CAN_STATUS_LOCKED },
-};
-
-static uint16_t status_bits(wc_status_t status)
-{
-    uint16_t bits = 0u;
-#if defined(__GNUC__) && !defined(__clang__) && !defined(__OPTIMIZE_SIZE__)
-#pragma GCC unroll 8  /* seven fixed entries, every period (bench/arm) */
-#endif
-    for (size_t i = 0u; i < (sizeof status_map / sizeof status_map[0]); ++i) {
-        if ((status & status_map[i].model) != 0u) { bits = (uint16_t)(bits | status_map[i].can); }
-    }
-    return bits;
 }
 
 void wc_loop_shift_report_frame(const wc_shift_report_t *q, wc_can_frame_t *out)
@@ -396,12 +355,6 @@ static WC_NOINLINE uint32_t encode_whole_shift(wc_loop_t *loop, wc_can_frame_t o
     return n + WC_LOOP_TX_WHOLE_SHIFT;
 }
 
-/* What prepare() found for the model step and finish(), with this period's
- * status bits (bits 0..15, WC_CAN_STATUS_*) in one word. */
-#define STEP_SHIFT (1uL << 16)   /* the shift controller steps the clutch */
-#define STEP_SAFE (1uL << 17)    /* the safe state is active */
-#define STEP_REPORT (1uL << 18)  /* a shift ended: ShiftReport */
-#define STEP_ADAPT (1uL << 19)   /* the learned values changed or were reset: AdaptationReport, the hook */
 /* prepare() sets the clutch input field by field: all of them (a new field fails here). */
 WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 15u * 4u, the_loop_sets_every_field_of_the_clutch_input);
 WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_bits_below_the_step_flags);
@@ -432,32 +385,31 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     }
     uint32_t step = loop->pending_status;
     loop->pending_status = 0u;
-    if (update_freshness(&loop->sensors_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts)) {
+    if (wc_loop_gearbox(&loop->config)) { return step | STEP_GEARBOX; }  /* wc_loop_gearbox_run does the rest */
+    if (wc_loop_update_freshness(&loop->sensors_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts)) {
         step |= WC_CAN_STATUS_SENSOR_TIMEOUT;
     }
-    if (update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
+    if (wc_loop_update_freshness(&loop->request_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts)) {
         step |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
     /* Shift mode: ShiftCommand is a control input too (its staleness counts as the request's). */
     const bool shift_mode = (loop->config.shift != NULL) && (loop->request.mode == WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE);
     if ((loop->config.shift != NULL) &&
-        update_freshness(&loop->shift_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts) &&
+        wc_loop_update_freshness(&loop->shift_in, loop->config.request_timeout_periods, &loop->counters.request_timeouts) &&
         shift_mode) {
         step |= WC_CAN_STATUS_REQUEST_TIMEOUT;
     }
     /* The whole shift (DESIGN 14): in Shift mode OffgoingSensors is a sensor input too. */
     if (wc_loop_whole_shift(&loop->config) &&
-        update_freshness(&loop->offgoing_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts) &&
+        wc_loop_update_freshness(&loop->offgoing_in, loop->config.sensor_timeout_periods, &loop->counters.sensor_timeouts) &&
         shift_mode) {
         step |= WC_CAN_STATUS_SENSOR_TIMEOUT;
     }
     /* Debounce: both control inputs fresh for recovery_periods in a row. */
-    const bool fresh = (step & (WC_CAN_STATUS_SENSOR_TIMEOUT | WC_CAN_STATUS_REQUEST_TIMEOUT)) == 0u;
-    loop->fresh_periods = fresh ? ((loop->fresh_periods < UINT32_MAX) ? loop->fresh_periods + 1u : UINT32_MAX) : 0u;
-    const bool safe = !fresh || (loop->fresh_periods < loop->config.recovery_periods);
+    const bool safe = wc_loop_safe_after(loop, step);
     uint32_t bench_timeouts = 0u;  /* bench frames are optional: staleness is not a fault */
     const bool bench_fresh = loop->config.bench_input_enabled &&
-                             !update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
+                             !wc_loop_update_freshness(&loop->bench_in, loop->config.sensor_timeout_periods, &bench_timeouts);
     const float load_cell_N = loop->bench.load_cell_force_N;
 
     /* the clutch input, field by field into the loop (no copy of a whole struct) */
@@ -524,7 +476,7 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
 /* After the model: the model's status bits, the output frames, the counters. */
 static WC_NOINLINE uint32_t finish(wc_loop_t *loop, uint32_t step, wc_can_frame_t out[WC_LOOP_TX_FRAMES])
 {
-    encode_outputs(loop, (uint16_t)(step | status_bits(loop->last.status)), out);
+    encode_outputs(loop, (uint16_t)(step | wc_loop_status_bits(loop->last.status)), out);
     uint32_t n = WC_LOOP_TX_CYCLIC;
     if (wc_loop_whole_shift(&loop->config)) { n = encode_whole_shift(loop, out, n); }
     if ((step & STEP_REPORT) != 0u) { wc_loop_shift_report_frame(&loop->report, &out[n++]); }
@@ -547,8 +499,10 @@ static WC_NOINLINE uint32_t run(wc_loop_t *loop, const wc_can_frame_t *frame, bo
 {
     if (frame != NULL) { (void)wc_loop_receive(loop, frame); }  /* a refusal is counted (WC_REJECT_OVERFLOW) */
     if (!step_now) { return 0u; }
-    WC_ASSERT(loop->clutch.model.cal != NULL);  /* initialised, and its init succeeded */
+    /* initialised, and its init succeeded */
+    WC_ASSERT((loop->clutch.model.cal != NULL) || (loop->transmission.element[0].model.cal != NULL));
     uint32_t step = prepare(loop);
+    if ((step & STEP_GEARBOX) != 0u) { return wc_loop_gearbox_run(loop, step & (uint32_t)~STEP_GEARBOX, out); }
     if ((step & STEP_SHIFT) != 0u) {
         /* the whole shift: loop->whole points at the off-going clutch (wc_loop_init); no copy on the stack */
         const bool ended = wc_shift_step(&loop->shift, loop->config.shift, &loop->command, (step & STEP_SAFE) != 0u,
@@ -585,7 +539,9 @@ uint32_t wc_loop_iterate(wc_loop_t *loop, wc_loop_clock_t clock, const wc_can_fr
     WC_ASSERT((loop != NULL) && (out != NULL));
     if ((loop == NULL) || (out == NULL)) { return 0u; }
     const bool step_now = tick || ((frame != NULL) && (clock == WC_LOOP_CLOCK_FRAME) &&
-                                   (frame->id == WC_CAN_CLUTCH_SENSORS_FRAME_ID) && (frame->flags == 0u));
+                                   (frame->id == (wc_loop_gearbox(&loop->config) ? WC_CAN_GEARBOX_SENSORS_FRAME_ID
+                                                                                 : WC_CAN_CLUTCH_SENSORS_FRAME_ID)) &&
+                                   (frame->flags == 0u));
     return run(loop, frame, step_now, out);
 }
 
@@ -594,6 +550,11 @@ uint32_t wc_loop_rx_ids(const wc_loop_config_t *config, uint32_t ids[WC_LOOP_RX_
     WC_ASSERT((config != NULL) && (ids != NULL));
     if ((config == NULL) || (ids == NULL)) { return 0u; }
     uint32_t n = 0u;
+    if (wc_loop_gearbox(config)) {
+        ids[n++] = WC_CAN_GEARBOX_SENSORS_FRAME_ID;
+        ids[n++] = WC_CAN_SHIFT_COMMAND_FRAME_ID;
+        return n;
+    }
     ids[n++] = WC_CAN_CLUTCH_SENSORS_FRAME_ID;
     ids[n++] = WC_CAN_TORQUE_REQUEST_FRAME_ID;
     if (config->shift != NULL) { ids[n++] = WC_CAN_SHIFT_COMMAND_FRAME_ID; }

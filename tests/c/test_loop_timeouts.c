@@ -59,7 +59,7 @@ static void sensor_timeout_case(fixture_t *fx, const wc_loop_config_t *config)
 
 /* Timeouts of the default configuration and two others (sensor, request). */
 static const wc_loop_config_t timeout_configs[] = {
-    { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL }, { 3u, 25u, { 2u, 1u }, 1u, false, NULL, NULL, NULL, NULL }, { 1u, 1u, { 2u, 2u }, 1u, false, NULL, NULL, NULL, NULL }
+    { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u }, { 3u, 25u, { 2u, 1u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u }, { 1u, 1u, { 2u, 2u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u }
 };
 
 static void test_sensor_timeout_and_recovery(void **state)

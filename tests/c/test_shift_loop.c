@@ -306,7 +306,7 @@ static uint32_t adaptive_period(loop_sim_t *l, int shift_request, bool reset, fl
     loop_queue_request(l, WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE);
     wc_can_frame_t f = wc_test_can_frame(WC_CAN_SHIFT_COMMAND_FRAME_ID);
     const wc_can_shift_command_phys_t c = { shift_request ? 1.0f : 0.0f, reset ? 1.0f : 0.0f, 2.0f, TURBINE_TORQUE_Nm,
-                                            1000.0f * TARGET_TIME_s, l->alive };
+                                            1000.0f * TARGET_TIME_s, 1.0f, l->alive };
     assert_int_equal(wc_can_encode_shift_command(f.data, &c, sizeof f.data), WC_CAN_OK);
     assert_true(wc_loop_receive(&l->loop, &f));
     l->alive = wc_e2e_counter_next(l->alive);

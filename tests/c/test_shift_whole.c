@@ -401,7 +401,7 @@ static void test_loop_whole_shift_frames(void **state)
         wc_can_frame_t in[4] = { wc_test_can_frame(WC_CAN_TORQUE_REQUEST_FRAME_ID), wc_test_can_frame(WC_CAN_SHIFT_COMMAND_FRAME_ID),
                                  wc_test_can_frame(WC_CAN_OFFGOING_SENSORS_FRAME_ID), wc_test_can_frame(WC_CAN_CLUTCH_SENSORS_FRAME_ID) };
         const wc_can_torque_request_phys_t q = { 0.0f, (uint8_t)WC_CAN_TORQUE_REQUEST_MODE_SHIFT_CHOICE, alive };
-        const wc_can_shift_command_phys_t c = { 0.0f, 0.0f, 2.0f, TURBINE_TORQUE_Nm, 500.0f, alive };
+        const wc_can_shift_command_phys_t c = { 0.0f, 0.0f, 2.0f, TURBINE_TORQUE_Nm, 500.0f, 1.0f, alive };
         const wc_can_offgoing_sensors_phys_t o = { 0.0f, alive };
         const wc_can_clutch_sensors_phys_t s = { 100.0f, THETA_OIL_degC, THETA_OIL_degC, alive };
         assert_int_equal(wc_can_encode_torque_request(in[0].data, &q, sizeof in[0].data), WC_CAN_OK);

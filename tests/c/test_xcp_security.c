@@ -30,7 +30,7 @@
 #define THETA_START_degC 40.0f
 #define CAL_BASE 0x00010000u
 
-static const wc_loop_config_t rig_config = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL };
+static const wc_loop_config_t rig_config = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u };
 
 typedef struct {
     wc_loop_t loop;

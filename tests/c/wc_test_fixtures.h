@@ -137,7 +137,7 @@ static inline wc_can_result_t wc_test_shift_command_frame(wc_can_frame_t *frame,
                                                           float turbine_torque_Nm, float target_ms, uint8_t alive)
 {
     *frame = wc_test_can_frame(WC_CAN_SHIFT_COMMAND_FRAME_ID);
-    const wc_can_shift_command_phys_t c = { request ? 1.0f : 0.0f, 0.0f, 2.0f, turbine_torque_Nm, target_ms, alive };
+    const wc_can_shift_command_phys_t c = { request ? 1.0f : 0.0f, 0.0f, 2.0f, turbine_torque_Nm, target_ms, 1.0f, alive };
     return wc_can_encode_shift_command(frame->data, &c, sizeof frame->data);
 }
 

@@ -289,7 +289,7 @@ static inline void fixture_init_with(fixture_t *fx, const wc_loop_config_t *conf
  * tests of steady behaviour see control from the first pair of frames. The
  * debounce, SyncCounter and the fault matrix use WC_LOOP_CONFIG_DEFAULT
  * itself (tests/c/test_loop_faults.c). */
-static const wc_loop_config_t config_no_debounce = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL };
+static const wc_loop_config_t config_no_debounce = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u };
 
 static inline void fixture_init(fixture_t *fx)
 {

@@ -29,7 +29,7 @@
 #define MODE_TORQUE WC_CAN_TORQUE_REQUEST_MODE_TORQUE_CONTROL_CHOICE
 
 /* Recovery after one fresh period (the steady tests see control at once); the image's limits hold it. */
-static const wc_loop_config_t rig_config = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL };
+static const wc_loop_config_t rig_config = { 10u, 10u, { 2u, 3u }, 1u, false, NULL, NULL, NULL, NULL, NULL, 1u };
 static const wc_xcp_config_t xcp_config = WC_XCP_CONFIG_DEFAULT;
 
 typedef struct {

@@ -43,6 +43,10 @@ FRAMES = {
     "OffgoingSensors": (0x113, "BENCH", {"TCU"}, 1, True),
     "OffgoingVfsCommand": (0x124, "TCU", {"BENCH"}, 1, True),
     "EngineTorqueRequest": (0x125, "TCU", {"ECU"}, 1, True),
+    # the transmission (DESIGN 15): the gearbox's speeds in, its status and one VFS command per element out
+    "GearboxSensors": (0x114, "BENCH", {"TCU"}, 1, True),
+    "GearboxStatus": (0x126, "TCU", {"VCU"}, 1, True),
+    **{f"Element{letter}VfsCommand": (0x128 + k, "TCU", {"BENCH"}, 1, True) for k, letter in enumerate("ABCDEF")},
     # XCP on CAN (DESIGN 13): event-driven command/response, not E2E, the lowest priority on the bus
     "XcpCommand": (0x7F0, "TOOL", {"TCU"}, None, False),
     "XcpResponse": (0x7F1, "TCU", {"TOOL"}, None, False),
@@ -64,6 +68,7 @@ STATUS_BITS = [  # VfsCommand status word bit n = frame bit 48 + n
 ]
 # Integer signals that the scaling wrapper does not convert.
 UNSCALED = {"Crc", "AliveCounter", "Mode", "LockState", "AbortReason", "Fallback", "XcpCommandPid", "XcpResponsePid",
+            "ShiftType", "Refusal", "Role", "Locked",
             "UdsFunctionalPci", "UdsPhysicalPci", "UdsResponsePci",
             *STATUS_BITS}
 
@@ -155,6 +160,39 @@ def test_status_bits(db):
         sig = msg.get_signal_by_name(name)
         assert (sig.start, sig.length) == (48 + n, 1)
         assert sig.comment.startswith(f"Status bit {n}:")
+
+
+def test_gearbox_status_carries_the_one_status_word(db):
+    """GearboxStatus has VfsCommand's status bits, same names, same order (the loop's one word; the
+    generator refuses two different words)."""
+    msg = db.get_message_by_name("GearboxStatus")
+    for n, name in enumerate(STATUS_BITS):
+        assert (msg.get_signal_by_name(name).start, msg.get_signal_by_name(name).length) == (32 + n, 1)
+    assert [s.name for s in msg.signals if s.name.startswith("Status")] == STATUS_BITS
+
+
+def test_element_commands_share_one_layout(db):
+    """The loop encodes every element's frame with element A's encoder and protects it with the element's
+    own data id (src/can/wc_loop_gearbox.c): the six layouts must be identical, the ids consecutive."""
+    def layout(m):
+        return [(s.name, s.start, s.length, s.is_signed, s.scale, s.offset, s.minimum, s.maximum, s.unit,
+                 dict(s.choices or {})) for s in m.signals]
+    first = db.get_message_by_name("ElementAVfsCommand")
+    for k, letter in enumerate("ABCDEF"):
+        m = db.get_message_by_name(f"Element{letter}VfsCommand")
+        assert m.frame_id == first.frame_id + k
+        assert layout(m) == layout(first), m.name
+
+
+def test_status_word_must_be_one_layout(tmp_path):
+    """The generator refuses a second frame whose Status* bits differ from the first's."""
+    from wetclutch.generate import can_descriptors
+    bad = DBC.read_text().replace(" SG_ StatusSensorTimeout : 32|1@1+", " SG_ StatusSensorTimeoutX : 32|1@1+")
+    bad = bad.replace("CM_ SG_ 294 StatusSensorTimeout ", "CM_ SG_ 294 StatusSensorTimeoutX ")
+    path = tmp_path / "bad.dbc"
+    path.write_text(bad)
+    with pytest.raises(can_descriptors.GenerateError, match="status"):
+        can_descriptors.messages(path)
 
 
 def _raw_limits(sig):
@@ -249,6 +287,12 @@ static const struct { const char *name; const wc_can_signal_t *sig; } sigs[] = {
     SIG(offgoing_sensors, offgoing_slip_speed), SIG(offgoing_vfs_command, shift_phase),
     SIG(offgoing_vfs_command, vfs_current), SIG(offgoing_vfs_command, pressure_command),
     SIG(engine_torque_request, intervention_active), SIG(engine_torque_request, torque_delta),
+    SIG(shift_command, current_gear), SIG(gearbox_sensors, oil_temp), SIG(gearbox_sensors, turbine_speed),
+    SIG(gearbox_sensors, output_speed), SIG(gearbox_sensors, housing_temp), SIG(gearbox_status, gear),
+    SIG(gearbox_status, target_gear), SIG(gearbox_status, shift_phase),
+#define ELEMENT(x) SIG(element_##x##_vfs_command, vfs_current), SIG(element_##x##_vfs_command, pressure_command), \
+                   SIG(element_##x##_vfs_command, estimated_temp)
+    ELEMENT(a), ELEMENT(b), ELEMENT(c), ELEMENT(d), ELEMENT(e), ELEMENT(f),
 };
 
 static float F(const char *s) { return strtof(s, NULL); }

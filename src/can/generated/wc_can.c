@@ -58,6 +58,14 @@ static inline uint8_t pack_left_shift_u32(
     return (uint8_t)((uint8_t)(value << shift) & mask);
 }
 
+static inline uint8_t pack_right_shift_u8(
+    uint8_t value,
+    uint8_t shift,
+    uint8_t mask)
+{
+    return (uint8_t)((uint8_t)(value >> shift) & mask);
+}
+
 static inline uint8_t pack_right_shift_u16(
     uint16_t value,
     uint8_t shift,
@@ -72,6 +80,14 @@ static inline uint8_t pack_right_shift_u32(
     uint8_t mask)
 {
     return (uint8_t)((uint8_t)(value >> shift) & mask);
+}
+
+static inline uint8_t unpack_left_shift_u8(
+    uint8_t value,
+    uint8_t shift,
+    uint8_t mask)
+{
+    return (uint8_t)((uint8_t)(value & mask) << shift);
 }
 
 static inline uint16_t unpack_left_shift_u16(
@@ -337,6 +353,7 @@ int wc_can_shift_command_pack(
     dst_p[4] |= pack_right_shift_u16(turbine_torque, 8u, 0xffu);
     dst_p[5] |= pack_left_shift_u16(src_p->target_inertia_time, 0u, 0xffu);
     dst_p[6] |= pack_right_shift_u16(src_p->target_inertia_time, 8u, 0x0fu);
+    dst_p[6] |= pack_left_shift_u8(src_p->current_gear, 4u, 0xf0u);
 
     return (8);
 }
@@ -362,6 +379,7 @@ int wc_can_shift_command_unpack(
     dst_p->turbine_torque = (int16_t)turbine_torque;
     dst_p->target_inertia_time = unpack_right_shift_u16(src_p[5], 0u, 0xffu);
     dst_p->target_inertia_time |= unpack_left_shift_u16(src_p[6], 8u, 0x0fu);
+    dst_p->current_gear = unpack_right_shift_u8(src_p[6], 4u, 0xf0u);
 
     return (0);
 }
@@ -447,6 +465,16 @@ bool wc_can_shift_command_target_inertia_time_is_in_phys_range(float value)
     return ((value >= 50.0f) && (value <= 2000.0f));
 }
 
+bool wc_can_shift_command_current_gear_is_in_range(uint8_t value)
+{
+    return (value <= 8u);
+}
+
+bool wc_can_shift_command_current_gear_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 8.0f));
+}
+
 int wc_can_offgoing_sensors_pack(
     uint8_t *dst_p,
     const struct wc_can_offgoing_sensors_t *src_p,
@@ -528,6 +556,133 @@ bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_range(int16_t value)
 bool wc_can_offgoing_sensors_offgoing_slip_speed_is_in_phys_range(float value)
 {
     return ((value >= -8000.0f) && (value <= 8000.0f));
+}
+
+int wc_can_gearbox_sensors_pack(
+    uint8_t *dst_p,
+    const struct wc_can_gearbox_sensors_t *src_p,
+    size_t size)
+{
+    uint16_t output_speed;
+    uint16_t turbine_speed;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u16(src_p->oil_temp, 4u, 0xf0u);
+    dst_p[2] |= pack_right_shift_u16(src_p->oil_temp, 4u, 0xffu);
+    turbine_speed = (uint16_t)src_p->turbine_speed;
+    dst_p[3] |= pack_left_shift_u16(turbine_speed, 0u, 0xffu);
+    dst_p[4] |= pack_right_shift_u16(turbine_speed, 8u, 0xffu);
+    output_speed = (uint16_t)src_p->output_speed;
+    dst_p[5] |= pack_left_shift_u16(output_speed, 0u, 0xffu);
+    dst_p[6] |= pack_right_shift_u16(output_speed, 8u, 0xffu);
+    dst_p[7] |= pack_left_shift_u8(src_p->housing_temp, 0u, 0xffu);
+
+    return (8);
+}
+
+int wc_can_gearbox_sensors_unpack(
+    struct wc_can_gearbox_sensors_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    uint16_t output_speed;
+    uint16_t turbine_speed;
+
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->oil_temp = unpack_right_shift_u16(src_p[1], 4u, 0xf0u);
+    dst_p->oil_temp |= unpack_left_shift_u16(src_p[2], 4u, 0xffu);
+    turbine_speed = unpack_right_shift_u16(src_p[3], 0u, 0xffu);
+    turbine_speed |= unpack_left_shift_u16(src_p[4], 8u, 0xffu);
+    dst_p->turbine_speed = (int16_t)turbine_speed;
+    output_speed = unpack_right_shift_u16(src_p[5], 0u, 0xffu);
+    output_speed |= unpack_left_shift_u16(src_p[6], 8u, 0xffu);
+    dst_p->output_speed = (int16_t)output_speed;
+    dst_p->housing_temp = unpack_right_shift_u8(src_p[7], 0u, 0xffu);
+
+    return (0);
+}
+
+int wc_can_gearbox_sensors_init(struct wc_can_gearbox_sensors_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_gearbox_sensors_t));
+
+    return 0;
+}
+
+bool wc_can_gearbox_sensors_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_gearbox_sensors_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_gearbox_sensors_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_gearbox_sensors_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_gearbox_sensors_oil_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 2500u));
+}
+
+bool wc_can_gearbox_sensors_oil_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 200.0f));
+}
+
+bool wc_can_gearbox_sensors_turbine_speed_is_in_range(int16_t value)
+{
+    return ((value >= -32000) && (value <= 32000));
+}
+
+bool wc_can_gearbox_sensors_turbine_speed_is_in_phys_range(float value)
+{
+    return ((value >= -8000.0f) && (value <= 8000.0f));
+}
+
+bool wc_can_gearbox_sensors_output_speed_is_in_range(int16_t value)
+{
+    return ((value >= -32000) && (value <= 32000));
+}
+
+bool wc_can_gearbox_sensors_output_speed_is_in_phys_range(float value)
+{
+    return ((value >= -8000.0f) && (value <= 8000.0f));
+}
+
+bool wc_can_gearbox_sensors_housing_temp_is_in_range(uint8_t value)
+{
+    return ((value >= 10u) && (value <= 250u));
+}
+
+bool wc_can_gearbox_sensors_housing_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 200.0f));
 }
 
 int wc_can_vfs_command_pack(
@@ -1450,6 +1605,1085 @@ bool wc_can_engine_torque_request_torque_delta_is_in_range(int16_t value)
 bool wc_can_engine_torque_request_torque_delta_is_in_phys_range(float value)
 {
     return ((value >= -1000.0f) && (value <= 1000.0f));
+}
+
+int wc_can_gearbox_status_pack(
+    uint8_t *dst_p,
+    const struct wc_can_gearbox_status_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->gear, 4u, 0xf0u);
+    dst_p[2] |= pack_left_shift_u8(src_p->target_gear, 0u, 0x0fu);
+    dst_p[2] |= pack_left_shift_u8(src_p->shift_phase, 4u, 0x70u);
+    dst_p[2] |= pack_left_shift_u8(src_p->shift_type, 7u, 0x80u);
+    dst_p[3] |= pack_right_shift_u8(src_p->shift_type, 1u, 0x01u);
+    dst_p[3] |= pack_left_shift_u8(src_p->refusal, 1u, 0x1eu);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_sensor_timeout, 0u, 0x01u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_request_timeout, 1u, 0x02u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_crc_error, 2u, 0x04u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_counter_error, 3u, 0x08u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_implausible_input, 4u, 0x10u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_saturated, 5u, 0x20u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_current_clamped, 6u, 0x40u);
+    dst_p[4] |= pack_left_shift_u8(src_p->status_below_drag, 7u, 0x80u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_safe_state_active, 0u, 0x01u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_deadline_miss, 1u, 0x02u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_over_temperature, 2u, 0x04u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_bench_input, 3u, 0x08u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_frame_lost, 4u, 0x10u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_bus_error, 5u, 0x20u);
+    dst_p[5] |= pack_left_shift_u8(src_p->status_locked, 6u, 0x40u);
+
+    return (8);
+}
+
+int wc_can_gearbox_status_unpack(
+    struct wc_can_gearbox_status_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->gear = unpack_right_shift_u8(src_p[1], 4u, 0xf0u);
+    dst_p->target_gear = unpack_right_shift_u8(src_p[2], 0u, 0x0fu);
+    dst_p->shift_phase = unpack_right_shift_u8(src_p[2], 4u, 0x70u);
+    dst_p->shift_type = unpack_right_shift_u8(src_p[2], 7u, 0x80u);
+    dst_p->shift_type |= unpack_left_shift_u8(src_p[3], 1u, 0x01u);
+    dst_p->refusal = unpack_right_shift_u8(src_p[3], 1u, 0x1eu);
+    dst_p->status_sensor_timeout = unpack_right_shift_u8(src_p[4], 0u, 0x01u);
+    dst_p->status_request_timeout = unpack_right_shift_u8(src_p[4], 1u, 0x02u);
+    dst_p->status_crc_error = unpack_right_shift_u8(src_p[4], 2u, 0x04u);
+    dst_p->status_counter_error = unpack_right_shift_u8(src_p[4], 3u, 0x08u);
+    dst_p->status_implausible_input = unpack_right_shift_u8(src_p[4], 4u, 0x10u);
+    dst_p->status_saturated = unpack_right_shift_u8(src_p[4], 5u, 0x20u);
+    dst_p->status_current_clamped = unpack_right_shift_u8(src_p[4], 6u, 0x40u);
+    dst_p->status_below_drag = unpack_right_shift_u8(src_p[4], 7u, 0x80u);
+    dst_p->status_safe_state_active = unpack_right_shift_u8(src_p[5], 0u, 0x01u);
+    dst_p->status_deadline_miss = unpack_right_shift_u8(src_p[5], 1u, 0x02u);
+    dst_p->status_over_temperature = unpack_right_shift_u8(src_p[5], 2u, 0x04u);
+    dst_p->status_bench_input = unpack_right_shift_u8(src_p[5], 3u, 0x08u);
+    dst_p->status_frame_lost = unpack_right_shift_u8(src_p[5], 4u, 0x10u);
+    dst_p->status_bus_error = unpack_right_shift_u8(src_p[5], 5u, 0x20u);
+    dst_p->status_locked = unpack_right_shift_u8(src_p[5], 6u, 0x40u);
+
+    return (0);
+}
+
+int wc_can_gearbox_status_init(struct wc_can_gearbox_status_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_gearbox_status_t));
+
+    return 0;
+}
+
+bool wc_can_gearbox_status_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_gearbox_status_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_gearbox_status_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_gearbox_status_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_gearbox_status_gear_is_in_range(uint8_t value)
+{
+    return (value <= 8u);
+}
+
+bool wc_can_gearbox_status_gear_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 8.0f));
+}
+
+bool wc_can_gearbox_status_target_gear_is_in_range(uint8_t value)
+{
+    return (value <= 8u);
+}
+
+bool wc_can_gearbox_status_target_gear_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 8.0f));
+}
+
+bool wc_can_gearbox_status_shift_phase_is_in_range(uint8_t value)
+{
+    return (value <= 6u);
+}
+
+bool wc_can_gearbox_status_shift_phase_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 6.0f));
+}
+
+bool wc_can_gearbox_status_shift_type_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_gearbox_status_shift_type_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_gearbox_status_refusal_is_in_range(uint8_t value)
+{
+    return (value <= 8u);
+}
+
+bool wc_can_gearbox_status_refusal_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 8.0f));
+}
+
+bool wc_can_gearbox_status_status_sensor_timeout_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_sensor_timeout_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_request_timeout_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_request_timeout_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_crc_error_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_crc_error_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_counter_error_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_counter_error_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_implausible_input_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_implausible_input_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_saturated_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_saturated_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_current_clamped_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_current_clamped_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_below_drag_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_below_drag_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_safe_state_active_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_safe_state_active_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_deadline_miss_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_deadline_miss_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_over_temperature_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_over_temperature_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_bench_input_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_bench_input_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_frame_lost_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_frame_lost_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_bus_error_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_bus_error_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_gearbox_status_status_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_gearbox_status_status_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+int wc_can_element_a_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_a_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_a_vfs_command_unpack(
+    struct wc_can_element_a_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_a_vfs_command_init(struct wc_can_element_a_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_a_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_a_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_a_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_a_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_a_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_a_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_a_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_a_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_a_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_a_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_a_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_a_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_a_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_a_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_a_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+int wc_can_element_b_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_b_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_b_vfs_command_unpack(
+    struct wc_can_element_b_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_b_vfs_command_init(struct wc_can_element_b_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_b_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_b_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_b_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_b_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_b_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_b_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_b_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_b_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_b_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_b_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_b_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_b_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_b_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_b_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_b_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+int wc_can_element_c_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_c_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_c_vfs_command_unpack(
+    struct wc_can_element_c_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_c_vfs_command_init(struct wc_can_element_c_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_c_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_c_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_c_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_c_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_c_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_c_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_c_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_c_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_c_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_c_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_c_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_c_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_c_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_c_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_c_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+int wc_can_element_d_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_d_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_d_vfs_command_unpack(
+    struct wc_can_element_d_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_d_vfs_command_init(struct wc_can_element_d_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_d_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_d_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_d_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_d_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_d_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_d_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_d_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_d_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_d_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_d_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_d_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_d_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_d_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_d_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_d_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+int wc_can_element_e_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_e_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_e_vfs_command_unpack(
+    struct wc_can_element_e_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_e_vfs_command_init(struct wc_can_element_e_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_e_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_e_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_e_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_e_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_e_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_e_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_e_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_e_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_e_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_e_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_e_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_e_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_e_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_e_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_e_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
+}
+
+int wc_can_element_f_vfs_command_pack(
+    uint8_t *dst_p,
+    const struct wc_can_element_f_vfs_command_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    memset(&dst_p[0], 0, 8);
+
+    dst_p[0] |= pack_left_shift_u8(src_p->crc, 0u, 0xffu);
+    dst_p[1] |= pack_left_shift_u8(src_p->alive_counter, 0u, 0x0fu);
+    dst_p[1] |= pack_left_shift_u8(src_p->role, 4u, 0x30u);
+    dst_p[1] |= pack_left_shift_u8(src_p->locked, 6u, 0x40u);
+    dst_p[2] |= pack_left_shift_u16(src_p->vfs_current, 0u, 0xffu);
+    dst_p[3] |= pack_right_shift_u16(src_p->vfs_current, 8u, 0xffu);
+    dst_p[4] |= pack_left_shift_u16(src_p->pressure_command, 0u, 0xffu);
+    dst_p[5] |= pack_right_shift_u16(src_p->pressure_command, 8u, 0xffu);
+    dst_p[6] |= pack_left_shift_u16(src_p->estimated_temp, 0u, 0xffu);
+    dst_p[7] |= pack_right_shift_u16(src_p->estimated_temp, 8u, 0x0fu);
+
+    return (8);
+}
+
+int wc_can_element_f_vfs_command_unpack(
+    struct wc_can_element_f_vfs_command_t *dst_p,
+    const uint8_t *src_p,
+    size_t size)
+{
+    if (size < 8u) {
+        return (-EINVAL);
+    }
+
+    dst_p->crc = unpack_right_shift_u8(src_p[0], 0u, 0xffu);
+    dst_p->alive_counter = unpack_right_shift_u8(src_p[1], 0u, 0x0fu);
+    dst_p->role = unpack_right_shift_u8(src_p[1], 4u, 0x30u);
+    dst_p->locked = unpack_right_shift_u8(src_p[1], 6u, 0x40u);
+    dst_p->vfs_current = unpack_right_shift_u16(src_p[2], 0u, 0xffu);
+    dst_p->vfs_current |= unpack_left_shift_u16(src_p[3], 8u, 0xffu);
+    dst_p->pressure_command = unpack_right_shift_u16(src_p[4], 0u, 0xffu);
+    dst_p->pressure_command |= unpack_left_shift_u16(src_p[5], 8u, 0xffu);
+    dst_p->estimated_temp = unpack_right_shift_u16(src_p[6], 0u, 0xffu);
+    dst_p->estimated_temp |= unpack_left_shift_u16(src_p[7], 8u, 0x0fu);
+
+    return (0);
+}
+
+int wc_can_element_f_vfs_command_init(struct wc_can_element_f_vfs_command_t *msg_p)
+{
+    if (msg_p == NULL) return -1;
+
+    memset(msg_p, 0, sizeof(struct wc_can_element_f_vfs_command_t));
+
+    return 0;
+}
+
+bool wc_can_element_f_vfs_command_crc_is_in_range(uint8_t value)
+{
+    (void)value;
+
+    return (true);
+}
+
+bool wc_can_element_f_vfs_command_crc_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 255.0f));
+}
+
+bool wc_can_element_f_vfs_command_alive_counter_is_in_range(uint8_t value)
+{
+    return (value <= 15u);
+}
+
+bool wc_can_element_f_vfs_command_alive_counter_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 15.0f));
+}
+
+bool wc_can_element_f_vfs_command_role_is_in_range(uint8_t value)
+{
+    return (value <= 3u);
+}
+
+bool wc_can_element_f_vfs_command_role_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 3.0f));
+}
+
+bool wc_can_element_f_vfs_command_locked_is_in_range(uint8_t value)
+{
+    return (value <= 1u);
+}
+
+bool wc_can_element_f_vfs_command_locked_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 1.0f));
+}
+
+bool wc_can_element_f_vfs_command_vfs_current_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_f_vfs_command_vfs_current_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 2000.0f));
+}
+
+bool wc_can_element_f_vfs_command_pressure_command_is_in_range(uint16_t value)
+{
+    return (value <= 64000u);
+}
+
+bool wc_can_element_f_vfs_command_pressure_command_is_in_phys_range(float value)
+{
+    return ((value >= 0.0f) && (value <= 4000.0f));
+}
+
+bool wc_can_element_f_vfs_command_estimated_temp_is_in_range(uint16_t value)
+{
+    return ((value >= 100u) && (value <= 4000u));
+}
+
+bool wc_can_element_f_vfs_command_estimated_temp_is_in_phys_range(float value)
+{
+    return ((value >= -40.0f) && (value <= 350.0f));
 }
 
 int wc_can_bench_measurement_pack(

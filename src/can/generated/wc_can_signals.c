@@ -42,9 +42,29 @@ const wc_can_signal_t wc_can_sig_shift_command_target_inertia_time = {
     .scale = 1.0f, .offset = 0.0f, .raw_min = 50, .raw_max = 2000,
     .raw_nan = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_SHIFT_COMMAND_TARGET_INERTIA_TIME_SNA_CHOICE, .has_sna = true,
 };
+const wc_can_signal_t wc_can_sig_shift_command_current_gear = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 8,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
 const wc_can_signal_t wc_can_sig_offgoing_sensors_offgoing_slip_speed = {
     .scale = 0.25f, .offset = 0.0f, .raw_min = -32000, .raw_max = 32000,
     .raw_nan = (int32_t)WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_OFFGOING_SENSORS_OFFGOING_SLIP_SPEED_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_gearbox_sensors_oil_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 2500,
+    .raw_nan = (int32_t)WC_CAN_GEARBOX_SENSORS_OIL_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_GEARBOX_SENSORS_OIL_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_gearbox_sensors_turbine_speed = {
+    .scale = 0.25f, .offset = 0.0f, .raw_min = -32000, .raw_max = 32000,
+    .raw_nan = (int32_t)WC_CAN_GEARBOX_SENSORS_TURBINE_SPEED_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_GEARBOX_SENSORS_TURBINE_SPEED_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_gearbox_sensors_output_speed = {
+    .scale = 0.25f, .offset = 0.0f, .raw_min = -32000, .raw_max = 32000,
+    .raw_nan = (int32_t)WC_CAN_GEARBOX_SENSORS_OUTPUT_SPEED_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_GEARBOX_SENSORS_OUTPUT_SPEED_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_gearbox_sensors_housing_temp = {
+    .scale = 1.0f, .offset = -50.0f, .raw_min = 10, .raw_max = 250,
+    .raw_nan = (int32_t)WC_CAN_GEARBOX_SENSORS_HOUSING_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_GEARBOX_SENSORS_HOUSING_TEMP_SNA_CHOICE, .has_sna = true,
 };
 const wc_can_signal_t wc_can_sig_vfs_command_vfs_current = {
     .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
@@ -157,6 +177,90 @@ const wc_can_signal_t wc_can_sig_engine_torque_request_intervention_active = {
 const wc_can_signal_t wc_can_sig_engine_torque_request_torque_delta = {
     .scale = 0.05f, .offset = 0.0f, .raw_min = -20000, .raw_max = 20000,
     .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_gearbox_status_gear = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 8,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_gearbox_status_target_gear = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 8,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_gearbox_status_shift_phase = {
+    .scale = 1.0f, .offset = 0.0f, .raw_min = 0, .raw_max = 6,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_a_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_a_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_a_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_A_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_A_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_element_b_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_b_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_b_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_B_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_B_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_element_c_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_c_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_c_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_C_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_C_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_element_d_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_d_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_d_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_D_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_D_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_element_e_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_e_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_e_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_E_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_E_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
+};
+const wc_can_signal_t wc_can_sig_element_f_vfs_command_vfs_current = {
+    .scale = 0.03125f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_f_vfs_command_pressure_command = {
+    .scale = 0.0625f, .offset = 0.0f, .raw_min = 0, .raw_max = 64000,
+    .raw_nan = 0, .raw_sna = 0, .has_sna = false,
+};
+const wc_can_signal_t wc_can_sig_element_f_vfs_command_estimated_temp = {
+    .scale = 0.1f, .offset = -50.0f, .raw_min = 100, .raw_max = 4000,
+    .raw_nan = (int32_t)WC_CAN_ELEMENT_F_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .raw_sna = (int32_t)WC_CAN_ELEMENT_F_VFS_COMMAND_ESTIMATED_TEMP_SNA_CHOICE, .has_sna = true,
 };
 const wc_can_signal_t wc_can_sig_bench_measurement_load_cell_force = {
     .scale = 0.1f, .offset = 0.0f, .raw_min = -200000, .raw_max = 200000,
@@ -314,6 +418,7 @@ wc_can_result_t wc_can_encode_shift_command(uint8_t *dst, const wc_can_shift_com
     msg.target_gear = (uint8_t)to_raw(&wc_can_sig_shift_command_target_gear, src->target_gear, &result);
     msg.turbine_torque = (int16_t)to_raw(&wc_can_sig_shift_command_turbine_torque, src->turbine_torque_Nm, &result);
     msg.target_inertia_time = (uint16_t)to_raw(&wc_can_sig_shift_command_target_inertia_time, src->target_inertia_time_ms, &result);
+    msg.current_gear = (uint8_t)to_raw(&wc_can_sig_shift_command_current_gear, src->current_gear, &result);
     msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
     msg.crc = 0u;
     if (wc_can_shift_command_pack(dst, &msg, size) < 0) {
@@ -342,6 +447,7 @@ wc_can_result_t wc_can_decode_shift_command(wc_can_shift_command_phys_t *dst, co
     dst->target_gear = to_phys(&wc_can_sig_shift_command_target_gear, msg.target_gear, &result);
     dst->turbine_torque_Nm = to_phys(&wc_can_sig_shift_command_turbine_torque, msg.turbine_torque, &result);
     dst->target_inertia_time_ms = to_phys(&wc_can_sig_shift_command_target_inertia_time, msg.target_inertia_time, &result);
+    dst->current_gear = to_phys(&wc_can_sig_shift_command_current_gear, msg.current_gear, &result);
     dst->alive_counter = msg.alive_counter;
     return result;
 }
@@ -381,6 +487,51 @@ wc_can_result_t wc_can_decode_offgoing_sensors(wc_can_offgoing_sensors_phys_t *d
         return WC_CAN_ERR_SIZE;
     }
     dst->offgoing_slip_speed_rpm = to_phys(&wc_can_sig_offgoing_sensors_offgoing_slip_speed, msg.offgoing_slip_speed, &result);
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* GearboxSensors (E2E) */
+
+wc_can_result_t wc_can_encode_gearbox_sensors(uint8_t *dst, const wc_can_gearbox_sensors_phys_t *src, size_t size)
+{
+    struct wc_can_gearbox_sensors_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_GEARBOX_SENSORS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.oil_temp = (uint16_t)to_raw(&wc_can_sig_gearbox_sensors_oil_temp, src->oil_temp_degC, &result);
+    msg.turbine_speed = (int16_t)to_raw(&wc_can_sig_gearbox_sensors_turbine_speed, src->turbine_speed_rpm, &result);
+    msg.output_speed = (int16_t)to_raw(&wc_can_sig_gearbox_sensors_output_speed, src->output_speed_rpm, &result);
+    msg.housing_temp = (uint8_t)to_raw(&wc_can_sig_gearbox_sensors_housing_temp, src->housing_temp_degC, &result);
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_gearbox_sensors_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_GEARBOX_SENSORS_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_gearbox_sensors(wc_can_gearbox_sensors_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_gearbox_sensors_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_GEARBOX_SENSORS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_GEARBOX_SENSORS_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_gearbox_sensors_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->oil_temp_degC = to_phys(&wc_can_sig_gearbox_sensors_oil_temp, msg.oil_temp, &result);
+    dst->turbine_speed_rpm = to_phys(&wc_can_sig_gearbox_sensors_turbine_speed, msg.turbine_speed, &result);
+    dst->output_speed_rpm = to_phys(&wc_can_sig_gearbox_sensors_output_speed, msg.output_speed, &result);
+    dst->housing_temp_degC = to_phys(&wc_can_sig_gearbox_sensors_housing_temp, msg.housing_temp, &result);
     dst->alive_counter = msg.alive_counter;
     return result;
 }
@@ -663,6 +814,398 @@ wc_can_result_t wc_can_decode_engine_torque_request(wc_can_engine_torque_request
     }
     dst->intervention_active = to_phys(&wc_can_sig_engine_torque_request_intervention_active, msg.intervention_active, &result);
     dst->torque_delta_Nm = to_phys(&wc_can_sig_engine_torque_request_torque_delta, msg.torque_delta, &result);
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* GearboxStatus (E2E) */
+
+wc_can_result_t wc_can_encode_gearbox_status(uint8_t *dst, const wc_can_gearbox_status_phys_t *src, size_t size)
+{
+    struct wc_can_gearbox_status_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_GEARBOX_STATUS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.gear = (uint8_t)to_raw(&wc_can_sig_gearbox_status_gear, src->gear, &result);
+    msg.target_gear = (uint8_t)to_raw(&wc_can_sig_gearbox_status_target_gear, src->target_gear, &result);
+    msg.shift_phase = (uint8_t)to_raw(&wc_can_sig_gearbox_status_shift_phase, src->shift_phase, &result);
+    msg.shift_type = (uint8_t)(src->shift_type & 0x03u);
+    if (src->shift_type > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.refusal = (uint8_t)(src->refusal & 0x0Fu);
+    if (src->refusal > 8u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_gearbox_status_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    const uint32_t status_bits = ((uint32_t)src->status & 0x7FFFu) << 0;  /* frame bits 32..46 */
+    dst[4] = (uint8_t)(dst[4] | (uint8_t)(status_bits >> 0));
+    dst[5] = (uint8_t)(dst[5] | (uint8_t)(status_bits >> 8));
+    (void)wc_e2e_protect(WC_CAN_GEARBOX_STATUS_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_gearbox_status(wc_can_gearbox_status_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_gearbox_status_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+    uint32_t status = 0u;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_GEARBOX_STATUS_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_GEARBOX_STATUS_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_gearbox_status_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->gear = to_phys(&wc_can_sig_gearbox_status_gear, msg.gear, &result);
+    dst->target_gear = to_phys(&wc_can_sig_gearbox_status_target_gear, msg.target_gear, &result);
+    dst->shift_phase = to_phys(&wc_can_sig_gearbox_status_shift_phase, msg.shift_phase, &result);
+    dst->shift_type = msg.shift_type;
+    if (!wc_can_gearbox_status_shift_type_is_in_range(msg.shift_type)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->refusal = msg.refusal;
+    if (!wc_can_gearbox_status_refusal_is_in_range(msg.refusal)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    status |= (uint32_t)src[4] << 0;
+    status |= (uint32_t)src[5] << 8;
+    dst->status = (uint16_t)((status >> 0) & 0x7FFFu);  /* frame bits 32..46 */
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementAVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_a_vfs_command(uint8_t *dst, const wc_can_element_a_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_a_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_A_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_a_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_a_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_a_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_a_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_A_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_a_vfs_command(wc_can_element_a_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_a_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_A_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_A_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_a_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_a_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_a_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_a_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_a_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_a_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementBVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_b_vfs_command(uint8_t *dst, const wc_can_element_b_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_b_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_B_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_b_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_b_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_b_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_b_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_B_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_b_vfs_command(wc_can_element_b_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_b_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_B_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_B_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_b_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_b_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_b_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_b_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_b_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_b_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementCVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_c_vfs_command(uint8_t *dst, const wc_can_element_c_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_c_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_C_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_c_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_c_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_c_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_c_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_C_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_c_vfs_command(wc_can_element_c_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_c_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_C_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_C_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_c_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_c_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_c_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_c_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_c_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_c_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementDVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_d_vfs_command(uint8_t *dst, const wc_can_element_d_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_d_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_D_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_d_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_d_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_d_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_d_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_D_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_d_vfs_command(wc_can_element_d_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_d_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_D_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_D_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_d_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_d_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_d_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_d_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_d_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_d_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementEVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_e_vfs_command(uint8_t *dst, const wc_can_element_e_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_e_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_E_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_e_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_e_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_e_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_e_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_E_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_e_vfs_command(wc_can_element_e_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_e_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_E_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_E_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_e_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_e_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_e_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_e_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_e_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_e_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->alive_counter = msg.alive_counter;
+    return result;
+}
+
+/* ElementFVfsCommand (E2E) */
+
+wc_can_result_t wc_can_encode_element_f_vfs_command(uint8_t *dst, const wc_can_element_f_vfs_command_phys_t *src, size_t size)
+{
+    struct wc_can_element_f_vfs_command_t msg = { 0u };  /* every field not set below is 0 */
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_F_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    msg.vfs_current = (uint16_t)to_raw(&wc_can_sig_element_f_vfs_command_vfs_current, src->vfs_current_mA, &result);
+    msg.pressure_command = (uint16_t)to_raw(&wc_can_sig_element_f_vfs_command_pressure_command, src->pressure_command_kPa, &result);
+    msg.estimated_temp = (uint16_t)to_raw(&wc_can_sig_element_f_vfs_command_estimated_temp, src->estimated_temp_degC, &result);
+    msg.role = (uint8_t)(src->role & 0x03u);
+    if (src->role > 3u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.locked = (uint8_t)(src->locked & 0x01u);
+    if (src->locked > 1u) { result = wc_can_worst_of(result, WC_CAN_ERR_RANGE); }
+    msg.alive_counter = (uint8_t)(src->alive_counter & WC_E2E_COUNTER_MASK);
+    msg.crc = 0u;
+    if (wc_can_element_f_vfs_command_pack(dst, &msg, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    (void)wc_e2e_protect(WC_CAN_ELEMENT_F_VFS_COMMAND_FRAME_ID, dst, size);
+    return result;
+}
+
+wc_can_result_t wc_can_decode_element_f_vfs_command(wc_can_element_f_vfs_command_phys_t *dst, const uint8_t *src, size_t size)
+{
+    struct wc_can_element_f_vfs_command_t msg;
+    wc_can_result_t result = WC_CAN_OK;
+
+    if ((dst == NULL) || (src == NULL) || (size < WC_CAN_ELEMENT_F_VFS_COMMAND_LENGTH)) {
+        return WC_CAN_ERR_SIZE;
+    }
+    if (wc_e2e_check_crc(WC_CAN_ELEMENT_F_VFS_COMMAND_FRAME_ID, src, size) != WC_E2E_OK) {
+        return WC_CAN_ERR_CRC;
+    }
+    if (wc_can_element_f_vfs_command_unpack(&msg, src, size) < 0) {
+        return WC_CAN_ERR_SIZE;
+    }
+    dst->vfs_current_mA = to_phys(&wc_can_sig_element_f_vfs_command_vfs_current, msg.vfs_current, &result);
+    dst->pressure_command_kPa = to_phys(&wc_can_sig_element_f_vfs_command_pressure_command, msg.pressure_command, &result);
+    dst->estimated_temp_degC = to_phys(&wc_can_sig_element_f_vfs_command_estimated_temp, msg.estimated_temp, &result);
+    dst->role = msg.role;
+    if (!wc_can_element_f_vfs_command_role_is_in_range(msg.role)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
+    dst->locked = msg.locked;
+    if (!wc_can_element_f_vfs_command_locked_is_in_range(msg.locked)) {
+        result = wc_can_worst_of(result, WC_CAN_ERR_RANGE);
+    }
     dst->alive_counter = msg.alive_counter;
     return result;
 }

@@ -15,7 +15,8 @@ the firmware needs on top of it so that no frame fact is restated by hand:
 
 Rules read from the DBC (an unsupported signal is an error, not a guess):
   Crc, AliveCounter         E2E fields (both present: the frame is E2E protected)
-  Status<Name>, 1 bit       bit (start - first status start) of a `status` word
+  Status<Name>, 1 bit       bit (start - first status start) of a `status` word (one word: every
+                            frame that carries it has the same bits in the same order)
   scale 1, offset 0, value
   table without SNA         an enumeration (raw integer, range from [min|max])
   anything else             a scaled float signal; VAL_ "SNA" is its reserved
@@ -135,6 +136,7 @@ def _signal(message, s) -> Signal:
 def messages(dbc_path: Path) -> list[Message]:
     db = cantools.database.load_file(str(dbc_path))
     out = []
+    out_status = None   # the status word's (name, bit) list, the same in every frame that carries it
     for m in db.messages:
         if m.length != 8:
             raise GenerateError(f"{m.name}: the codec handles classic 8-byte frames only")
@@ -148,6 +150,10 @@ def messages(dbc_path: Path) -> list[Message]:
                 raise GenerateError(f"{m.name}: status bits must be contiguous, at most 16")
         if len({s.kind for s in sigs} & {"crc", "counter"}) == 1:
             raise GenerateError(f"{m.name}: an E2E frame needs both Crc and AliveCounter")
+        if status and out_status is not None and [(s.name, s.bit) for s in status] != out_status:
+            raise GenerateError(f"{m.name}: its Status* bits differ from another frame's: one status word, one layout")
+        if status:
+            out_status = [(s.name, s.bit) for s in status]
         out.append(Message(m.name, camel_to_snake_case(m.name), m.frame_id, sigs,
                            status_start=min((s.start for s in m.signals if s.name.startswith("Status") and s.length == 1),
                                             default=0)))
@@ -187,11 +193,11 @@ def header(msgs: list[Message]) -> str:
            "#include <stddef.h>\n#include <stdint.h>\n\n",
            '#include "wc_can.h"\n#include "wc_can_scaling.h"\n\n',
            "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n"]
-    for m in msgs:
+    words = [m for m in msgs if m.of("status")]
+    for m in words[:1]:  # one status word: messages() checked that every frame carrying it has the same bits
         status = m.of("status")
-        if not status:
-            continue
-        out.append(f"/* {m.name} status word: bit n is the n-th Status* signal of the DBC. */\n")
+        carriers = ", ".join(w.name for w in words)
+        out.append(f"/* The status word ({carriers}): bit n is the n-th Status* signal of the DBC. */\n")
         for s in status:
             out.append(f"#define {PREFIX.upper()}_STATUS_{camel_to_snake_case(s.name[6:]).upper()} (1u << {s.bit})\n")
         mask = (1 << len(status)) - 1

@@ -194,7 +194,7 @@ def pedal_for_load(params, load: float, turbine_rpm: float) -> float:
 
 def _signals(s: dict, target_ms: int, request: bool, torque_Nm: float) -> dict:
     return {canlog.REQUEST: {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT},
-            canlog.SHIFT_COMMAND: {"ShiftRequest": int(request), "AdaptationReset": 0, "TargetGear": 2,
+            canlog.SHIFT_COMMAND: {"ShiftRequest": int(request), "AdaptationReset": 0, "TargetGear": 2, "CurrentGear": 1,
                                    "TurbineTorque": float(np.clip(torque_Nm, -1000.0, 1000.0)),
                                    "TargetInertiaTime": target_ms},
             canlog.OFFGOING_SENSORS: {"OffgoingSlipSpeed": float(np.clip(s["off"], -8000.0, 8000.0))},

@@ -114,7 +114,7 @@ def _one_shift(params, tcu, enc, db, scenario: Scenario, theta_clutch_degC, t0_s
         t = t0_s + k * dt
         s = pl.sensors()
         signals = {canlog.REQUEST: {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT},
-                   canlog.SHIFT_COMMAND: {"ShiftRequest": int(k >= n_pre), "AdaptationReset": 0, "TargetGear": 2,
+                   canlog.SHIFT_COMMAND: {"ShiftRequest": int(k >= n_pre), "AdaptationReset": 0, "TargetGear": 2, "CurrentGear": 1,
                                           "TurbineTorque": float(np.clip(s["turbine_torque_estimate_Nm"], -1000.0, 1000.0)),
                                           "TargetInertiaTime": round(target_s * 1e3)},
                    canlog.SENSORS: {"SlipSpeed": float(np.clip(s["slip_rpm"], -8000.0, 8000.0)),
@@ -205,7 +205,7 @@ def _idle_frames(oil_degC: float, housing_degC: float, target_ms: int) -> dict:
     db = canlog.database()
     out = {}
     for name, sig in ((canlog.REQUEST, {"TorqueRequest": 0.0, "Mode": canlog.MODE_SHIFT}),
-                      (canlog.SHIFT_COMMAND, {"ShiftRequest": 0, "AdaptationReset": 0, "TargetGear": 2,
+                      (canlog.SHIFT_COMMAND, {"ShiftRequest": 0, "AdaptationReset": 0, "TargetGear": 2, "CurrentGear": 1,
                                               "TurbineTorque": 0.0, "TargetInertiaTime": target_ms}),
                       (canlog.OFFGOING_SENSORS, {"OffgoingSlipSpeed": 0.0}),
                       (canlog.SENSORS, {"SlipSpeed": 0.0, "OilTemp": oil_degC, "HousingTemp": housing_degC})):
