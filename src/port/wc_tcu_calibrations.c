@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "wc_8hp_gearbox.h"
 #include "wc_bench_identified_calibration.h"
 #include "wc_shift_1_2_shift.h"
 #include "wc_table1_calibration.h"
@@ -30,6 +31,20 @@ const wc_shift_calibration_t *wc_tcu_find_shift_calibration(const char *name)
 {
     for (size_t i = 0; i < wc_tcu_shift_calibration_count; ++i) {
         if (strcmp(name, wc_tcu_shift_calibrations[i].name) == 0) { return wc_tcu_shift_calibrations[i].calibration; }
+    }
+    return NULL;
+}
+
+const wc_gearbox_t *wc_tcu_find_gearbox(const char *name)
+{
+    static const struct {
+        const char *name;
+        const wc_gearbox_t *gearbox;
+    } gearboxes[] = {
+        {"8hp", &wc_gearbox_8hp},  /* tools/gearboxes/8hp.toml: five elements, eight forward gears and reverse */
+    };
+    for (size_t i = 0; i < sizeof gearboxes / sizeof gearboxes[0]; ++i) {
+        if (strcmp(name, gearboxes[i].name) == 0) { return gearboxes[i].gearbox; }
     }
     return NULL;
 }

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "wetclutch/wc_calibration.h"
+#include "wetclutch/wc_gearbox.h"
 #include "wetclutch/wc_shift.h"
 
 typedef struct {
@@ -29,5 +30,9 @@ extern const size_t wc_tcu_shift_calibration_count;
 
 /* The named shift calibration, or NULL. */
 const wc_shift_calibration_t *wc_tcu_find_shift_calibration(const char *name);
+
+/* Gearbox descriptions (DESIGN 15), selected with --gearbox NAME: the tables
+ * `wetclutch gearbox` generates (lut/wc_<name>_gearbox.h). The named one, or NULL. */
+const wc_gearbox_t *wc_tcu_find_gearbox(const char *name);
 
 #endif /* WC_TCU_CALIBRATIONS_H */
