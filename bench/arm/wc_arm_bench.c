@@ -194,6 +194,8 @@ const char *const row_name[ROWS] = {
     [ROW_TX_POWER_OFF_UP] = "wc_transmission_step:power_off_up",
     [ROW_TX_POWER_ON_DOWN] = "wc_transmission_step:power_on_down",
     [ROW_TX_POWER_OFF_DOWN] = "wc_transmission_step:power_off_down",
+    [ROW_LOOP_GEARBOX_IN_GEAR] = "wc_loop_step:gearbox_in_gear",
+    [ROW_LOOP_GEARBOX_POWER_ON_UP] = "wc_loop_step:gearbox_power_on_up",
 };
 
 /* Shift trajectory: the inertia phase lasts at most target * timeout factor = 750 periods; the whole

@@ -86,6 +86,8 @@ typedef enum {
     ROW_TX_POWER_OFF_UP,
     ROW_TX_POWER_ON_DOWN,
     ROW_TX_POWER_OFF_DOWN,
+    ROW_LOOP_GEARBOX_IN_GEAR,
+    ROW_LOOP_GEARBOX_POWER_ON_UP,
     ROWS
 } row_t;
 
