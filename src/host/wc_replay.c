@@ -59,6 +59,7 @@
 #include "wc_cal_image_file.h"
 #include "wc_loop_stats.h"
 #include "wc_tcu_calibrations.h"
+#include "wc_tcu_gearbox.h"
 
 static int parse_line(const char *line, double *t_s, wc_can_frame_t *frame)
 {
@@ -162,8 +163,7 @@ static int write_stats(const char *path, const wc_loop_counters_t *counters)
               " [--lockstep]\n" \
               "       --offgoing-calibration-image FILE: the whole shift's off-going clutch (an image, shift off)\n" \
               "       --stats-json FILE: the loop's counters at the end, as wc_tcu --stats-json writes them\n" \
-              "       --gearbox NAME (8hp) [--element-image FILE]... [--start-gear N] [--holding-margin F]" \
-              " [--holding-floor NM]: the transmission\n"
+              WC_TCU_GEARBOX_USAGE
 
 int main(int argc, char **argv)
 {
@@ -179,14 +179,12 @@ int main(int argc, char **argv)
     int calibration_given = 0;
     int bench = 0;
     double theta_start_degC = 40.0;  /* as wc_tcu --theta-start */
-    const char *gearbox_name = NULL;           /* --gearbox */
-    const char *element_paths[WC_GEARBOX_ELEMENTS_MAX];
-    size_t element_count = 0u;                 /* --element-image given */
-    unsigned long start_gear = 1u;
-    double holding_margin = 1.3;
-    double holding_floor_Nm = 10.0;
+    wc_tcu_gearbox_options_t gearbox = WC_TCU_GEARBOX_OPTIONS_DEFAULT;  /* --gearbox and its options */
     for (int i = 1; i < argc; ++i) {
         char *end = NULL;
+        const int gearbox_option = wc_tcu_gearbox_option("wc_replay", argc, argv, &i, &gearbox);
+        if (gearbox_option < 0) { return 2; }
+        if (gearbox_option > 0) { continue; }
         if (strcmp(argv[i], "--bench") == 0) { bench = 1; }
         else if (strcmp(argv[i], "--lockstep") == 0) { lockstep = 1; }
         else if ((strcmp(argv[i], "--shift") == 0) && (i + 1 < argc) && (shift_name == NULL)) {
@@ -217,19 +215,6 @@ int main(int argc, char **argv)
                  (offgoing_image_path == NULL)) {
             offgoing_image_path = argv[++i];
         }
-        else if ((strcmp(argv[i], "--gearbox") == 0) && (i + 1 < argc) && (gearbox_name == NULL)) {
-            gearbox_name = argv[++i];
-        }
-        else if ((strcmp(argv[i], "--element-image") == 0) && (i + 1 < argc) &&
-                 (element_count < WC_GEARBOX_ELEMENTS_MAX)) {
-            element_paths[element_count++] = argv[++i];
-        }
-        else if ((strcmp(argv[i], "--start-gear") == 0) && (i + 1 < argc) &&
-                 ((void)(start_gear = strtoul(argv[i + 1], &end, 10)), (end != argv[i + 1]) && (*end == '\0'))) { ++i; }
-        else if ((strcmp(argv[i], "--holding-margin") == 0) && (i + 1 < argc) &&
-                 ((void)(holding_margin = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0'))) { ++i; }
-        else if ((strcmp(argv[i], "--holding-floor") == 0) && (i + 1 < argc) &&
-                 ((void)(holding_floor_Nm = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0'))) { ++i; }
         else if ((strcmp(argv[i], "--theta-start") == 0) && (i + 1 < argc) &&
                  ((void)(theta_start_degC = strtod(argv[i + 1], &end)), (end != argv[i + 1]) && (*end == '\0')) &&
                  (theta_start_degC >= -40.0) && (theta_start_degC <= 250.0)) { ++i; }
@@ -296,46 +281,12 @@ int main(int argc, char **argv)
     }
     static wc_transmission_config_t transmission;  /* --gearbox: the loop keeps pointers into these */
     static wc_cal_set_t element_images[WC_GEARBOX_ELEMENTS_MAX];
-    if (gearbox_name != NULL) {
-        const wc_gearbox_t *gearbox = wc_tcu_find_gearbox(gearbox_name);
-        if (gearbox == NULL) {
-            fprintf(stderr, "wc_replay: --gearbox: '%s' is not compiled in\n", gearbox_name);
-            return 2;
-        }
-        if ((config.shift == NULL) || (offgoing_image_path != NULL) || (adaptation_path != NULL) || bench) {
-            fprintf(stderr, "wc_replay: --gearbox needs a shift calibration (--shift NAME or an image with it) and"
-                            " takes no --offgoing-calibration-image, --adaptation-file or --bench\n");
-            return 2;
-        }
-        if ((element_count != 0u) && (element_count != gearbox->element_count)) {
-            fprintf(stderr, "wc_replay: --gearbox %s has %u elements: give --element-image for each, or none\n",
-                    gearbox_name, (unsigned)gearbox->element_count);
-            return 2;
-        }
-        transmission.gearbox = gearbox;
-        for (size_t e = 0u; e < gearbox->element_count; ++e) {
-            transmission.element[e] = cal;
-            if (element_count == 0u) { continue; }
-            if (wc_cal_image_file_load(element_paths[e], "wc_replay", &element_images[e]) != 0) { return 2; }
-            transmission.element[e] = &element_images[e].clutch;
-        }
-        transmission.shift = config.shift;
-        transmission.holding_margin_factor = (float)holding_margin;
-        transmission.holding_floor_Nm = (float)holding_floor_Nm;
-        static wc_transmission_t check;  /* wc_transmission_init says why it refuses; the loop would say WC_CAL_NULL */
-        const wc_transmission_error_t tx_error =
-            wc_transmission_init(&check, &transmission, (uint32_t)start_gear, (float)theta_start_degC);
-        if (tx_error != WC_TRANSMISSION_OK) {
-            fprintf(stderr, "wc_replay: --gearbox %s refused (wc_transmission_error_t %d: gearbox 2, element 3,"
-                            " shift 4, holding 5, start gear 6)\n", gearbox_name, (int)tx_error);
-            return 2;
-        }
-        config.transmission = &transmission;
-        config.transmission_start_gear = (uint32_t)start_gear;
-        config.shift = NULL;  /* the transmission's own */
-        config.offgoing = NULL;  /* an image's whole shift: its elements are the transmission's */
-    } else if (element_count != 0u) {
-        fprintf(stderr, "wc_replay: --element-image needs --gearbox\n");
+    if ((gearbox.gearbox != NULL) && ((offgoing_image_path != NULL) || (adaptation_path != NULL) || bench)) {
+        fprintf(stderr, "wc_replay: --gearbox takes no --offgoing-calibration-image, --adaptation-file or --bench\n");
+        return 2;
+    }
+    if (wc_tcu_gearbox_config("wc_replay", &gearbox, cal, (float)theta_start_degC, &config, &transmission,
+                              element_images) != 0) {
         return 2;
     }
     if ((config.shift != NULL) && (config.shift->coordinator == 1u) && (config.offgoing == NULL)) {

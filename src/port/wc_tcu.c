@@ -34,6 +34,7 @@
 #include "wc_cal_image_file.h"
 #include "wc_loop_stats.h"
 #include "wc_tcu_calibrations.h"
+#include "wc_tcu_gearbox.h"
 #include "wc_xcp_signals.h"
 #include "wc_tcu_diag.h"
 
@@ -71,6 +72,7 @@ typedef struct {
     unsigned security_delay_ms;  /* --security-delay-ms */
     unsigned dtc_aging_cycles;   /* --dtc-aging-cycles */
     unsigned uds_frames_per_step;  /* --uds-frames-per-step */
+    wc_tcu_gearbox_options_t gearbox;  /* --gearbox and its options: the transmission (DESIGN 15) */
 } options_t;
 
 static volatile sig_atomic_t stop_requested = 0;
@@ -132,7 +134,10 @@ static void usage(FILE *out)
             "      --request-timeout N   TorqueRequest timeout in periods (default 10)\n"
             "  -b, --bench               use BenchMeasurement (0x130: load cell, torque sensor) as the\n"
             "                            paper's validation does; off: the frame is filtered out\n"
-            "      --realtime            SCHED_FIFO priority 50 and mlockall, where permitted (reported)\n"
+            "      --realtime            SCHED_FIFO priority 50 and mlockall, where permitted (reported)\n");
+    fputs(WC_TCU_GEARBOX_USAGE
+          "                        (not with --xcp, --uds, --bench, --adaptation-file: not there yet)\n", out);
+    fprintf(out,
             "      --xcp                 XCP on CAN slave (XcpCommand 0x7F0 / XcpResponse 0x7F1): calibration page\n"
             "                            and DAQ for a calibration tool (README: Calibration over XCP)\n"
             "      --uds                 UDS diagnostics over ISO-TP (UdsPhysicalRequest 0x7E1, UdsFunctionalRequest\n"
@@ -209,14 +214,26 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"dtc-file", required_argument, NULL, 10},     {"serial", required_argument, NULL, 11},
         {"security-delay-ms", required_argument, NULL, 12}, {"uds-frames-per-step", required_argument, NULL, 13},
         {"dtc-aging-cycles", required_argument, NULL, 14},
+        {"gearbox", required_argument, NULL, 15},      {"element-image", required_argument, NULL, 15},
+        {"start-gear", required_argument, NULL, 15},   {"holding-margin", required_argument, NULL, 15},
+        {"holding-floor", required_argument, NULL, 15},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u, .security_delay_ms = 10000u, .dtc_aging_cycles = 40u,
-                     .uds_frames_per_step = 1u};
+                     .uds_frames_per_step = 1u, .gearbox = WC_TCU_GEARBOX_OPTIONS_DEFAULT};
     double v = 0.0;
     int c;
-    while ((c = getopt_long(argc, argv, "i:c:p:k:s:n:I:t:j:bh", longopts, NULL)) != -1) {
+    int index = 0;
+    while ((c = getopt_long(argc, argv, "i:c:p:k:s:n:I:t:j:bh", longopts, &index)) != -1) {
         switch (c) {
+        case 15: {  /* the transmission's options, parsed as wc_replay parses them */
+            char name[32];
+            (void)snprintf(name, sizeof name, "--%s", longopts[index].name);
+            char *pair[2] = { name, optarg };
+            int at = 0;
+            if (wc_tcu_gearbox_option("wc_tcu", 2, pair, &at, &o->gearbox) != 1) { return -1; }
+            break;
+        }
         case 'i': o->iface = optarg; break;
         case 'c':
             if (strcmp(optarg, "timer") == 0) { o->frame_clock = 0; }
@@ -267,6 +284,10 @@ static int parse_options(int argc, char **argv, options_t *o)
     }
     if (o->uds && (o->secret_file == NULL)) {
         fprintf(stderr, "wc_tcu: --uds needs --secret-file FILE (the device secret of SecurityAccess)\n");
+        return -1;
+    }
+    if ((o->gearbox.gearbox != NULL) && (o->xcp || o->uds || o->bench || (o->adaptation_file != NULL))) {
+        fprintf(stderr, "wc_tcu: --gearbox: not with --xcp, --uds, --bench or --adaptation-file (not there yet)\n");
         return -1;
     }
     if ((o->calibration_image != NULL) && o->compiled_in_given) {
@@ -567,6 +588,12 @@ int main(int argc, char **argv)
         }
     }
     config.bench_input_enabled = opt.bench != 0;
+    static wc_transmission_config_t transmission;  /* --gearbox: the loop keeps pointers into these */
+    static wc_cal_set_t element_images[WC_GEARBOX_ELEMENTS_MAX];
+    if (wc_tcu_gearbox_config("wc_tcu", &opt.gearbox, cal, (float)opt.theta_start_degC, &config, &transmission,
+                              element_images) != 0) {
+        return 2;
+    }
     if ((config.shift != NULL) && (config.shift->coordinator == 1u) && (config.offgoing == NULL)) {
         config.offgoing = cal;  /* DESIGN 14: the off-going clutch has the same lining (its own instance) */
     }

@@ -103,3 +103,30 @@ def test_the_frames_of_every_period(shifts, case):
     assert 2 in roles_seen                       # the on-coming element named while the shift runs
     changes = [(a, b) for a, b in zip(gears, gears[1:]) if a != b]
     assert changes == [(source, target)]
+
+
+BAD_GEARBOX_OPTIONS = [
+    (["--gearbox", "9hp", "--shift", "shift_1_2_whole_full"], "not compiled in"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_full"], "coordinator"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--start-gear", "2.5"], "not a gear number"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--start-gear", "9"], "start gear 6"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--element-image", "/nonexistent.img"], "5 elements"),
+    (["--element-image", "/nonexistent.img"], "needs --gearbox"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--holding-margin", "0.5"], "--holding-margin"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--bench"], "--bench"),
+]
+
+
+@pytest.mark.parametrize("program", ["wc_replay", "wc_tcu"])
+@pytest.mark.parametrize("args,says", BAD_GEARBOX_OPTIONS, ids=[s for _, s in BAD_GEARBOX_OPTIONS])
+def test_bad_gearbox_options_are_one_line_and_exit_2(program, args, says):
+    """The transmission's options, shared by wc_replay and wc_tcu (src/port/wc_tcu_gearbox.c): a refused one is
+    one line on stderr naming it and exit 2, before any frame or socket (wc_tcu refuses before SocketCAN)."""
+    import subprocess
+    path = transmission8.ROOT / "build" / "host-release" / "src" / ("host" if program == "wc_replay" else "port") / program
+    if not path.is_file():
+        pytest.skip(f"{program} not built")
+    cmd = [str(path), *(["-"] if program == "wc_replay" else []), *args]
+    res = subprocess.run(cmd, capture_output=True, text=True, stdin=subprocess.DEVNULL, timeout=30)
+    assert res.returncode == 2, res.stderr
+    assert says in res.stderr and res.stderr.count("\n") == 1 and res.stdout == ""
