@@ -130,3 +130,49 @@ def test_bad_gearbox_options_are_one_line_and_exit_2(program, args, says):
     res = subprocess.run(cmd, capture_output=True, text=True, stdin=subprocess.DEVNULL, timeout=30)
     assert res.returncode == 2, res.stderr
     assert says in res.stderr and res.stderr.count("\n") == 1 and res.stdout == ""
+
+
+HOLD_S = 0.6           # in each gear: the TCU's start-up safe state (23 periods at the maximum), then its holding
+SLIP_LIMIT_RPM = 5.0   # issue 29: in a gear at full load no closed element slips more than 5 rpm
+
+
+def test_every_gear_held_at_full_load_without_slip_below_the_maximum():
+    """Issue 29's in-gear target through the frames: in every forward gear at full load (pedal 1, turbine near
+    2500 rpm) the TCU holds the gear's three elements at its holding need x 1.3 (not at the maximum current)
+    and none of them slips more than 5 rpm by the plant's truth; the two open elements get the minimum."""
+    from wetclutch.shift.matrix8 import LOCKUP_MA, RPM, _plant_and_models, plant_path
+    from wetclutch.simulate.gearbox_plant import Plant8
+    params, _ = _plant_and_models(str(plant_path("nominal")))
+    v = params.vehicle
+    rows = []
+    for gear in range(1, 9):
+        g = str(gear)
+        ratio = float(transmission8.kinematics.ratio(params.gearbox, g))
+        plant = Plant8.in_gear(params, g, 2500.0 * RPM / ratio / v.final_drive * v.wheel_radius, pedal=1.0,
+                               lockup_current_mA=LOCKUP_MA, oil_degC=80.0)
+        tx = FrameTransmission(params.gearbox.path, gear, 80.0)
+        try:
+            st, worst_slip, currents, ratio_cap = plant.state, 0.0, {}, {}
+            closed = params.gearbox.gears[g]
+            for k in range(int(round(HOLD_S / plant.dt))):
+                o = tx.step(False, gear, gear, st["engine_torque_Nm"], 0.5, st["turbine_speed_rpm"] * RPM,
+                            st["output_speed_rpm"] * RPM, plant.oil_degC, plant.housing_degC)
+                currents = {e: float(o.current_mA[i]) for i, e in enumerate(ELEMENTS)}
+                st = plant.step(currents, LOCKUP_MA, 1.0, 0.0)
+                if k * plant.dt >= 0.1:   # after the start-up's safe state and the VFS lag
+                    worst_slip = max(worst_slip, max(abs(st[f"{e}_slip_rad_s"]) / RPM for e in closed))
+                    assert o.status & 0x100 == 0, f"gear {gear}: safe state at {k} ms"
+            for e in closed:
+                ratio_cap[e] = st[f"{e}_capacity_Nm"] / max(abs(st[f"{e}_torque_Nm"]), 1e-9)
+        finally:
+            tx.close()
+        rows.append((gear, worst_slip, currents, ratio_cap))
+        print(f"\ngear {gear}: worst closed-element slip {worst_slip:.2f} rpm; currents " +
+              ", ".join(f"{e} {c:.0f}" for e, c in currents.items()) + " mA; capacity / carried " +
+              ", ".join(f"{e} {r:.2f}" for e, r in ratio_cap.items()))
+        assert worst_slip <= SLIP_LIMIT_RPM, f"gear {gear}"
+        for e in ELEMENTS:
+            if e in closed:
+                assert currents[e] < 999.0, f"gear {gear}: {e} at the maximum current"   # table1's VFS: 1000 mA
+            else:
+                assert currents[e] == pytest.approx(0.0, abs=1.0 / 32.0), f"gear {gear}: open {e}"
