@@ -5,8 +5,6 @@ shifts with wc_transmission_step called directly (transmission8's ctypes path): 
 quantisation, so the shifts agree to what that quantisation explains."""
 from __future__ import annotations
 
-import math
-
 import pytest
 
 from wetclutch.shift import transmission8
@@ -19,32 +17,25 @@ CASES = transmission8.CASES[:4]   # 2->3 and 3->2, each type once
 
 
 @pytest.fixture(scope="module")
-def shifts(tmp_path_factory):
-    """Each case run both ways: (frames, direct, the frames' per-period records)."""
+def shifts():
+    """Each case run both ways: (through the frames, direct, the frames' recorded log)."""
     if not transmission8.LIBRARY.is_file():
         pytest.skip("libwc_transmission_host not built (cmake --build --preset host-release)")
     out = {}
     for source, target, kind in CASES:
         direct = transmission8.run_shift("nominal", source, target, kind)
-        records = []
+        made = []
 
-        def factory(path, gear, theta, lib=None, records=records):
-            tx = FrameTransmission(path, gear, theta)
-            step = tx.step
-
-            def recorded(*args):
-                o = step(*args)
-                records.append(o)
-                return o
-            tx.step = recorded
-            return tx
+        def factory(path, gear, theta, lib=None, made=made):
+            made.append(FrameTransmission(path, gear, theta, lib=lib, record=True))
+            return made[-1]
         mp = pytest.MonkeyPatch()
         mp.setattr(transmission8, "Transmission", factory)
         try:
             frames = transmission8.run_shift("nominal", source, target, kind)
         finally:
             mp.undo()
-        out[(source, target, kind)] = (frames, direct, records)
+        out[(source, target, kind)] = (frames, direct, made[0].log)
     return out
 
 
@@ -67,42 +58,80 @@ def test_every_type_completes_through_frames_as_in_process(shifts, case):
     assert abs(frames["peak_theta_estimate_degC"] - direct["peak_theta_estimate_degC"]) <= 1.0
 
 
+def _periods(log):
+    out: dict[int, list] = {}
+    for k, fid, data in log:
+        out.setdefault(k, []).append((fid, data))
+    return [out[k] for k in sorted(out)]
+
+
 @pytest.mark.parametrize("case", CASES, ids=[f"{s}-{t}-{k.replace(' ', '_')}" for s, t, k in CASES])
 def test_the_frames_of_every_period(shifts, case):
-    """Every period: one E2E command per element (its own data id, counter +1 mod 16), GearboxStatus and
-    EngineTorqueRequest, ShiftReport once; the roles name the shift's elements; no fault bit; the gear moves
-    from the source to the target once, at the shift's end."""
-    _, _, records = shifts[case]
+    """Every period, decoded here with cantools (not the C codec that made them): one E2E command per element
+    (its own data id, counter +1 mod 16), GearboxStatus and EngineTorqueRequest, ShiftReport once; the roles name
+    the shift's elements; no fault bit; the gear moves from the source to the target once, at the shift's end."""
+    _, _, log = shifts[case]
     source, target, _ = case
     db = canlog.database()
     ids = [db.get_message_by_name(n).frame_id for n in canlog.ELEMENT_COMMANDS[:len(ELEMENTS)]]
-    status_id = db.get_message_by_name(canlog.GEARBOX_STATUS).frame_id
+    status_msg = db.get_message_by_name(canlog.GEARBOX_STATUS)
     engine_id = db.get_message_by_name(canlog.ENGINE_REQUEST).frame_id
-    last_counter, reports, gears = {}, 0, []
+    fault_bits = ("StatusSensorTimeout", "StatusRequestTimeout", "StatusCrcError", "StatusCounterError",
+                  "StatusImplausibleInput")
+    last_counter, reports, gears, roles_seen = {}, 0, [], set()
     oncoming = transmission8._oncoming_index(transmission8._plant_and_models(   # noqa: SLF001
         str(transmission8.plant_path("nominal")))[0], str(source), str(target))
-    roles_seen = set()
-    fault_bits = 0b11111   # sensor timeout, request timeout, CRC, counter, implausible (GearboxStatus bits 0-4)
-    for k, o in enumerate(records):
-        sent = [fid for fid, _ in o.frames]
-        assert sent[:len(ids) + 2] == ids + [status_id, engine_id], f"period {k}"
+    for k, frames in enumerate(_periods(log)):
+        sent = [fid for fid, _ in frames[2:]]           # the first two: ShiftCommand, GearboxSensors (in)
+        assert sent[:len(ids) + 2] == ids + [status_msg.frame_id, engine_id], f"period {k}"
         assert len(sent) in (len(ids) + 2, len(ids) + 3)
         reports += len(sent) == len(ids) + 3
-        for fid, data in o.frames:
-            if fid in ids + [status_id, engine_id]:
+        for fid, data in frames[2:]:
+            if fid in ids + [status_msg.frame_id, engine_id]:
                 assert bytes(canlog.protect(fid, bytearray(data))) == data, f"period {k}: CRC of {fid:#x}"
                 counter = data[1] & 0x0F
                 if fid in last_counter:
                     assert counter == (last_counter[fid] + 1) % 16
                 last_counter[fid] = counter
-        assert o.status & fault_bits == 0, f"period {k}: status {o.status:#x}"
-        assert all(0.0 <= c <= 2000.0 and math.isfinite(c) for c in o.current_mA)
-        roles_seen.add(o.roles[oncoming])
-        gears.append(o.gear)
+            if fid in ids:
+                sig = db.get_message_by_frame_id(fid).decode(data, decode_choices=False)
+                assert 0.0 <= sig["VfsCurrent"] <= 2000.0
+                if ids.index(fid) == oncoming:
+                    roles_seen.add(sig["Role"])
+            if fid == status_msg.frame_id:
+                st = status_msg.decode(data, decode_choices=False)
+                assert not any(st[b] for b in fault_bits), f"period {k}: {st}"
+                gears.append(int(st["Gear"]))
     assert reports == 1
     assert 2 in roles_seen                       # the on-coming element named while the shift runs
     changes = [(a, b) for a, b in zip(gears, gears[1:]) if a != b]
     assert changes == [(source, target)]
+
+
+@pytest.mark.parametrize("case", CASES[:2], ids=[f"{s}-{t}-{k.replace(' ', '_')}" for s, t, k in CASES[:2]])
+def test_wc_replay_answers_the_recorded_inputs_with_the_same_frames(shifts, case, tmp_path):
+    """The program: wc_replay --gearbox (the same loop, src/host/wc_replay.c) given the closed loop's input
+    frames as a candump log answers with exactly the frames the in-process loop sent, period by period."""
+    import subprocess
+    from wetclutch.shift.transmission_frames import element_images, shift_image, write_inputs_log
+    _, _, log = shifts[case]
+    path = transmission8.plant_path("nominal")
+    gearbox_path = transmission8._plant_and_models(str(path))[0].gearbox.path   # noqa: SLF001
+    args = ["--gearbox", "8hp", "--start-gear", str(case[0]), "--theta-start", "80"]
+    for e, image in zip(ELEMENTS, element_images(gearbox_path)):
+        (tmp_path / f"{e}.img").write_bytes(image)
+        args += ["--element-image", str(tmp_path / f"{e}.img")]
+    (tmp_path / "shift.img").write_bytes(shift_image(gearbox_path))
+    n_in = write_inputs_log(log, tmp_path / "in.log")
+    program = transmission8.ROOT / "build" / "host-release" / "src" / "host" / "wc_replay"
+    res = subprocess.run([str(program), str(tmp_path / "in.log"), "--calibration-image", str(tmp_path / "shift.img"),
+                          *args], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    replayed = [line.split()[2].split("#") for line in res.stdout.splitlines()]
+    replayed = [(int(i, 16), bytes.fromhex(d)) for i, d in replayed]
+    in_process = [(fid, data) for frames in _periods(log) for fid, data in frames[2:]]
+    assert n_in == 2 * len(_periods(log)) > 1000
+    assert replayed == in_process
 
 
 BAD_GEARBOX_OPTIONS = [
@@ -144,6 +173,8 @@ def test_every_gear_held_at_full_load_without_slip_below_the_maximum():
     from wetclutch.simulate.gearbox_plant import Plant8
     params, _ = _plant_and_models(str(plant_path("nominal")))
     v = params.vehicle
+    db = canlog.database()
+    status_id = db.get_message_by_name(canlog.GEARBOX_STATUS).frame_id
     rows = []
     for gear in range(1, 9):
         g = str(gear)
@@ -161,7 +192,8 @@ def test_every_gear_held_at_full_load_without_slip_below_the_maximum():
                 st = plant.step(currents, LOCKUP_MA, 1.0, 0.0)
                 if k * plant.dt >= 0.1:   # after the start-up's safe state and the VFS lag
                     worst_slip = max(worst_slip, max(abs(st[f"{e}_slip_rad_s"]) / RPM for e in closed))
-                    assert o.status & 0x100 == 0, f"gear {gear}: safe state at {k} ms"
+                    status = db.decode_message(status_id, dict(tx.frames())[status_id])
+                    assert status["StatusSafeStateActive"] == 0, f"gear {gear}: safe state at {k} ms"
             for e in closed:
                 ratio_cap[e] = st[f"{e}_capacity_Nm"] / max(abs(st[f"{e}_torque_Nm"]), 1e-9)
         finally:

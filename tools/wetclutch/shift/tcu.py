@@ -24,18 +24,6 @@ class InprocTcu:
             cmd += ["--set", f"{k}={v:.9g}"]
         if adaptation_file is not None:
             cmd += ["--adaptation-file", str(adaptation_file)]
-        self._start(cmd)
-
-    @classmethod
-    def with_arguments(cls, arguments: list[str], program: Path = WC_REPLAY) -> "InprocTcu":
-        """wc_replay - --lockstep with these arguments (the transmission's: --gearbox ..., transmission_frames)."""
-        if not Path(program).is_file():
-            raise ShiftError(f"{program} not built (cmake --preset host-release && cmake --build --preset host-release)")
-        tcu = cls.__new__(cls)
-        tcu._start([str(program), "-", "--lockstep", *arguments])
-        return tcu
-
-    def _start(self, cmd: list[str]) -> None:
         self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      text=True, bufsize=1)
 

@@ -1,33 +1,33 @@
 """The transmission through its CAN frames (issue 29 item 3; DESIGN 15): the firmware's frame loop with
-config.transmission, in process (wc_replay --gearbox --lockstep through a pipe, the same wc_loop_iterate as
-wc_tcu), driven with the frames a vehicle's TCU receives and read back from the frames it sends.
+config.transmission, in process through ctypes (libwc_transmission_host's frames mode,
+src/host/wc_transmission_host.c: the same wc_loop_iterate as wc_tcu and wc_replay --gearbox), driven with the
+frames a vehicle's TCU receives and read back from the frames it sends.
 
 Each period the caller's values go out as ShiftCommand (ShiftRequest, CurrentGear, TargetGear, TurbineTorque,
 TargetInertiaTime) and GearboxSensors (turbine and output speed, oil and housing temperature; last: it steps
-the loop on the frame clock), each with its E2E CRC and alive counter (wetclutch.util.canlog.Encoder); what
+the loop on the frame clock), each with its E2E CRC and alive counter, encoded by the generated codec; what
 comes back is one ElementXVfsCommand per element, GearboxStatus, EngineTorqueRequest and, when a shift ends,
-ShiftReport, decoded with the DBC. So every value crosses its DBC scaling both ways: speeds in 0.25 rpm,
+ShiftReport, decoded the same way. So every value crosses its DBC scaling both ways: speeds in 0.25 rpm,
 temperatures in 0.1 K (the housing in 1 K), the turbine torque in 0.05 N m, currents in 1/32 mA.
 
-FrameTransmission.step has the signature and the result fields of transmission8.Transmission.step (the
-ctypes path, wc_transmission_step alone), so a closed loop can run either: the difference is the frames.
+FrameTransmission.step has the signature and the result record of transmission8.Transmission.step (which calls
+wc_transmission_step alone), so a closed loop can run either: the difference is the frames. With record=True
+each step's frames in and out are kept (frames_log: a candump -L log that wc_replay --gearbox replays).
 """
 from __future__ import annotations
 
-import math
-import tempfile
-from dataclasses import dataclass, field
+import ctypes
 from pathlib import Path
 
 from ..calibration import cal_image, shift as shift_calibration
 from ..util import canlog
 from .matrix8 import CONTROLLER, _element_clutch_values
 from .scenarios import SHIFT_TOML, ShiftError
-from .tcu import InprocTcu
+from .transmission8 import _library, _Step
 
 ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
-GEARBOX = "8hp"                              # wc_replay --gearbox (the table compiled in)
-RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+GEARBOX = "8hp"                              # wc_replay --gearbox: the table libwc_transmission_host has
+MAX_FRAMES = 2 + 9                           # a step's frames: ShiftCommand, GearboxSensors, WC_LOOP_TX_FRAMES
 
 
 def element_images(gearbox_path) -> list[bytes]:
@@ -48,90 +48,55 @@ def shift_image(gearbox_path) -> bytes:
                                         **cal_image.loop_values(None, True)})
 
 
-@dataclass
-class FrameStep:
-    """One period's outputs, decoded from the frames (fields as transmission8._Step)."""
-    current_mA: list = field(default_factory=list)
-    theta_degC: list = field(default_factory=list)
-    engine_delta_Nm: float = 0.0
-    engine_active: int = 0
-    gear: int = 0
-    phase: int = 0
-    type: int = 0
-    refusal: int = 0
-    ended: int = 0
-    report: list = field(default_factory=list)   # inertia s, RMSE rad/s, jerk, energy J, peak theta, flare,
-    #                                              tie-up, abort reason, fallback (NaN: not on the bus)
-    status: int = 0                              # GearboxStatus's status word (bit n: the n-th Status* signal)
-    roles: list = field(default_factory=list)
-    frames: list = field(default_factory=list)   # (id, data) as sent, for frame-level checks
-
-
 class FrameTransmission:
-    """wc_replay --gearbox 8hp --lockstep on the gearbox's element images and the shift image."""
+    """The frame loop with the transmission on the gearbox's element images and the shift image, in process."""
 
     def __init__(self, gearbox_path, gear: int, theta_start_degC: float, holding_margin: float = 1.3,
-                 holding_floor_Nm: float = 10.0):
-        self._dir = tempfile.TemporaryDirectory(prefix="wc_transmission_frames_")
-        d = Path(self._dir.name)
-        args = ["--gearbox", GEARBOX]
-        for e, image in zip(ELEMENTS, element_images(gearbox_path)):
-            (d / f"{e}.img").write_bytes(image)
-            args += ["--element-image", str(d / f"{e}.img")]
-        (d / "shift.img").write_bytes(shift_image(gearbox_path))
-        args += ["--calibration-image", str(d / "shift.img"), "--start-gear", str(int(gear)),
-                 "--theta-start", f"{theta_start_degC:.6g}", "--holding-margin", f"{holding_margin:.9g}",
-                 "--holding-floor", f"{holding_floor_Nm:.9g}"]
-        self.tcu = InprocTcu.with_arguments(args)
-        self.enc = canlog.Encoder()
-        db = self.enc.db
-        self.messages = {m.frame_id: m for m in db.messages}
-        self.element_ids = [db.get_message_by_name(n).frame_id for n in canlog.ELEMENT_COMMANDS[:len(ELEMENTS)]]
-        self.status_id = db.get_message_by_name(canlog.GEARBOX_STATUS).frame_id
-        self.engine_id = db.get_message_by_name(canlog.ENGINE_REQUEST).frame_id
-        self.report_id = db.get_message_by_name(canlog.SHIFT_REPORT).frame_id
-        self.status_bits = [s.name for s in db.get_message_by_name(canlog.GEARBOX_STATUS).signals
-                            if s.name.startswith("Status")]
+                 holding_floor_Nm: float = 10.0, lib=None, record: bool = False):
+        self.lib = lib or _library()
+        u, f = ctypes.c_uint32, ctypes.c_float
+        self.lib.wc_host_tx_init_frames.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
+        self.lib.wc_host_tx_frames.argtypes = [ctypes.c_void_p, ctypes.POINTER(u), ctypes.c_char_p, u]
+        self.lib.wc_host_tx_frames.restype = u
+        images = [*element_images(gearbox_path), shift_image(gearbox_path)]
+        self.state = ctypes.create_string_buffer(self.lib.wc_host_tx_size())
+        lengths = (u * len(images))(*[len(b) for b in images])
+        rc = self.lib.wc_host_tx_init_frames(self.state, b"".join(images), lengths, gear, theta_start_degC,
+                                             holding_margin, holding_floor_Nm)
+        if rc != 0:
+            raise ShiftError(f"wc_host_tx_init_frames refused the configuration (code {rc})")
+        self.out = _Step()
+        self.record = record
+        self.log: list[tuple[int, int, bytes]] = []      # (period, id, data), inputs first, with record
+        self._ids = (u * MAX_FRAMES)()
+        self._data = ctypes.create_string_buffer(8 * MAX_FRAMES)
         self.k = 0
 
-    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> FrameStep:
-        frames = [self.enc.frame(canlog.SHIFT_COMMAND, ShiftRequest=int(bool(request)), AdaptationReset=0,
-                                 TargetGear=int(target), CurrentGear=int(current),
-                                 TurbineTorque=min(max(float(torque_Nm), -1000.0), 1000.0),
-                                 TargetInertiaTime=round(float(target_s) * 1e3)),
-                  self.enc.frame(canlog.GEARBOX_SENSORS, TurbineSpeed=_clip_rpm(w_t), OutputSpeed=_clip_rpm(w_o),
-                                 OilTemp=float(oil), HousingTemp=float(round(housing)))]
-        out = self.tcu.exchange(1.0e6 + self.k * 1e-3, frames)
+    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> _Step:
+        rc = self.lib.wc_host_tx_step(self.state, int(request), current, target, torque_Nm, target_s, w_t, w_o, oil,
+                                      housing, 0, ctypes.byref(self.out))
+        if rc != 0:
+            raise ShiftError(f"the frame loop's step {self.k}: its frames did not decode (code {rc})")
+        if self.record:
+            self.log.extend((self.k, fid, data) for fid, data in self.frames())
         self.k += 1
-        return self._decode(out)
+        return self.out
 
-    def _decode(self, out) -> FrameStep:
-        o = FrameStep(current_mA=[math.nan] * len(ELEMENTS), theta_degC=[math.nan] * len(ELEMENTS),
-                      roles=[0] * len(ELEMENTS), frames=out)
-        for fid, data in out:
-            sig = self.messages[fid].decode(data, decode_choices=False)
-            if fid in self.element_ids:
-                e = self.element_ids.index(fid)
-                o.current_mA[e], o.theta_degC[e], o.roles[e] = sig["VfsCurrent"], sig["EstimatedTemp"], sig["Role"]
-            elif fid == self.status_id:
-                o.gear, o.phase, o.type, o.refusal = (int(sig["Gear"]), int(sig["ShiftPhase"]), int(sig["ShiftType"]),
-                                                      int(sig["Refusal"]))
-                o.status = sum(int(sig[b]) << n for n, b in enumerate(self.status_bits))
-            elif fid == self.engine_id:
-                o.engine_active, o.engine_delta_Nm = int(sig["InterventionActive"]), float(sig["TorqueDelta"])
-            elif fid == self.report_id:
-                o.ended = 1
-                o.report = [sig["InertiaPhaseTime"] * 1e-3, sig["SlipRmse"] / RPM_PER_RAD_S, sig["PeakJerk"],
-                            sig["FrictionEnergy"] * 1e3, sig["PeakClutchTemp"], sig["Flare"], sig["TieUp"],
-                            sig["AbortReason"], math.nan]
-        if any(math.isnan(c) for c in o.current_mA):
-            raise ShiftError(f"wc_replay --gearbox: a period without every element's VFS command: {out}")
-        return o
+    def frames(self) -> list[tuple[int, bytes]]:
+        """The last step's frames: ShiftCommand, GearboxSensors, then what the loop sent (id, 8 bytes)."""
+        n = self.lib.wc_host_tx_frames(self.state, self._ids, self._data, MAX_FRAMES)
+        raw = self._data.raw
+        return [(int(self._ids[i]), raw[8 * i:8 * i + 8]) for i in range(n)]
 
     def close(self) -> None:
-        self.tcu.close()
-        self._dir.cleanup()
+        """Nothing held outside the process (kept for the closed loops' symmetry with the pipe-driven TCUs)."""
 
 
-def _clip_rpm(w_rad_s: float) -> float:
-    return min(max(float(w_rad_s) * RPM_PER_RAD_S, -8000.0), 8000.0)
+def write_inputs_log(log: list[tuple[int, int, bytes]], path: Path, dt_s: float = 1e-3) -> int:
+    """The recorded input frames (ShiftCommand, GearboxSensors of every period) as a candump -L log, the
+    period's time stamp; returns the number of frames. wc_replay --gearbox on it sends the recorded outputs."""
+    db = canlog.database()
+    inputs = {db.get_message_by_name(n).frame_id for n in (canlog.SHIFT_COMMAND, canlog.GEARBOX_SENSORS)}
+    lines = [f"({1.0e6 + k * dt_s:.6f}) vcan0 {fid:03X}#{data.hex().upper()}\n" for k, fid, data in log if fid in inputs]
+    Path(path).write_text("".join(lines))
+    return len(lines)
