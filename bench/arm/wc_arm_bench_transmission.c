@@ -43,6 +43,7 @@ typedef struct {
     float turbine_rad_s;
     float output_rad_s;
     float turbine_torque_Nm;
+    float engine_Nm;             /* what the engine delivers of the transmission's request (the rig's lag) */
 } tx_plant_t;
 
 /* One measured (or not) step with the request current -> target, then the plant. */
@@ -56,7 +57,7 @@ static void tx_step(tx_plant_t *p, bool request, uint32_t current, uint32_t targ
         thunk_transmission_step(&bench);
     }
     wc_test_tx_plant(&wc_gearbox_8hp, &tx, &tx_output, p->turbine_torque_Nm, wc_arm_calibration->control_period_s,
-                     &p->turbine_rad_s, &p->output_rad_s);
+                     &p->engine_Nm, &p->turbine_rad_s, &p->output_rad_s);
 }
 
 /* Start in gear from, settle, then measure every step of the shift from -> to; it must complete. */
@@ -67,7 +68,7 @@ static void tx_shift(uint32_t from, uint32_t to, float turbine_torque_Nm, row_t 
         return;
     }
     (void)memset(&tx_output, 0, sizeof tx_output);
-    tx_plant_t p = { wc_gearbox_8hp.ratio[from] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, turbine_torque_Nm };
+    tx_plant_t p = { wc_gearbox_8hp.ratio[from] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, turbine_torque_Nm, 0.0f };
     for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { tx_step(&p, false, from, to, row, false); }
     bench.tx_ended = false;
     for (uint32_t k = 0u; (k < TX_SHIFT_STEPS_MAX) && !bench.tx_ended; ++k) { tx_step(&p, true, from, to, row, true); }
@@ -100,7 +101,7 @@ static void loop_step(tx_plant_t *p, bool request, uint32_t current, uint32_t ta
         thunk_loop_step(&bench);
     }
     wc_test_tx_plant(&wc_gearbox_8hp, &gearbox_loop.transmission, &gearbox_loop.transmission_out, p->turbine_torque_Nm,
-                     wc_arm_calibration->control_period_s, &p->turbine_rad_s, &p->output_rad_s);
+                     wc_arm_calibration->control_period_s, &p->engine_Nm, &p->turbine_rad_s, &p->output_rad_s);
 }
 
 static void bench_gearbox_loop(void)
@@ -114,7 +115,7 @@ static void bench_gearbox_loop(void)
     }
     wc_loop_t *kept = bench.loop;
     bench.loop = &gearbox_loop;
-    tx_plant_t p = { wc_gearbox_8hp.ratio[3] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 200.0f };
+    tx_plant_t p = { wc_gearbox_8hp.ratio[3] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 200.0f, 0.0f };
     for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { loop_step(&p, false, 3u, 3u, ROW_LOOP_GEARBOX_IN_GEAR, false); }
     for (uint32_t k = 0u; k < TX_IN_GEAR_STEPS; ++k) { loop_step(&p, false, 3u, 3u, ROW_LOOP_GEARBOX_IN_GEAR, true); }
     config.transmission_start_gear = 2u;
@@ -124,7 +125,7 @@ static void bench_gearbox_loop(void)
         bench.loop = kept;
         return;
     }
-    p = (tx_plant_t){ wc_gearbox_8hp.ratio[2] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 150.0f };
+    p = (tx_plant_t){ wc_gearbox_8hp.ratio[2] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 150.0f, 0.0f };
     for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { loop_step(&p, false, 2u, 2u, ROW_LOOP_GEARBOX_POWER_ON_UP, false); }
     bench.tx_frames = 0u;
     const uint32_t with_report = wc_gearbox_8hp.element_count + 3u;  /* the cyclic frames and the ShiftReport */
@@ -155,7 +156,7 @@ void bench_transmission(void)
         return;
     }
     (void)memset(&tx_output, 0, sizeof tx_output);
-    tx_plant_t p = { wc_gearbox_8hp.ratio[3] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 200.0f };
+    tx_plant_t p = { wc_gearbox_8hp.ratio[3] * TX_OUTPUT_rad_s, TX_OUTPUT_rad_s, 200.0f, 0.0f };
     for (uint32_t k = 0u; k < TX_SETTLE_STEPS; ++k) { tx_step(&p, false, 3u, 3u, ROW_TX_IN_GEAR, false); }
     for (uint32_t k = 0u; k < TX_IN_GEAR_STEPS; ++k) { tx_step(&p, false, 3u, 3u, ROW_TX_IN_GEAR, true); }
 

@@ -370,18 +370,23 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  * off-going clutch (offgoing, required) lets the turbine run to the target
  * gear's speed on the reference slip while the on-coming clutch (clutch)
  * waits filled at its kiss point; at synchronism the torque phase hands the
- * torque over. In the controller's frame the turbine torque is >= 0, the
- * on-coming slip starts negative (the turbine below the target gear's speed)
- * and the off-going slip turns positive. Phases:
- *   PREPARE   prepare_time_s: the on-coming clutch filled (the fill pulse,
- *             then the kiss point); the off-going request ramps from
+ * torque over. In the controller's frame the turbine torque is >= 0 (with
+ * WC_SHIFT_INERTIA_FIRST_ENGINE <= 0), the on-coming slip starts negative (the
+ * turbine below the target gear's speed) and the off-going slip turns
+ * positive. Phases:
+ *   PREPARE   prepare_time_s: with the assist the on-coming clutch filled (the
+ *             fill pulse, then the kiss point); without it the fill is timed
+ *             to arrive at synchronism: open until the reference leaves
+ *             prepare_time_s, then the fill pulse and the kiss point (filled
+ *             early it drags across the whole slip: a tie-up). The
+ *             off-going request ramps from
  *             offgoing_holding_factor x T_t to (1 + offgoing_margin_factor) x T_t,
  *             just above what it carries.
  *   INERTIA   the reference slip from the on-coming slip at the phase start
  *             (below -min_start_slip_rad_s, else AbortReason 6) to 0 as in
  *             the torque-first shift; the hold-back = feed-forward
  *             (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out) + PI(slip -
- *             reference) is the off-going request. Without oncoming_assist
+ *             reference) is the off-going request. Without WC_SHIFT_INERTIA_FIRST_ASSIST
  *             (the kickdown: the engine sets the pace) the on-coming clutch
  *             waits at its kiss point and a target faster than T_t can move
  *             the turbine is stretched to the time it can (1.25 x 1.5
@@ -406,12 +411,24 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  *             torque phase on finished on the model (the ramps on time, never
  *             reported locked without the slip), released after
  *             fallback_time_s.
- * No engine request (engine_active false) and no adaptation in this type
- * yet; the report's friction energy is both clutches' (the off-going one
- * does the inertia phase's work), its jerk that of the output torque
- * T_c + (b1 / b) T_1, tie_up never set (the plant measures it). */
+ * With WC_SHIFT_INERTIA_FIRST_ENGINE (the coast downshift, not mirrored: T_t
+ * <= 0, the engine drags and cannot raise the turbine) the engine does the
+ * inertia phase (DESIGN 15: "engine torque increase requested"): the request
+ * I_t dref/dt - T_t0 at the reference engine_lead_time_s ahead, plus what the
+ * PI asks beyond the hold-back's feed-forward when the turbine lags (x k_1
+ * I_t), at most engine_increase_max_Nm, ramped out over the torque phase; the
+ * off-going clutch only holds back (>= 0) when the turbine runs ahead, and
+ * the target is stretched to what T_t0 + engine_increase_max_Nm can do.
+ * The on-coming clutch then never drags the vehicle into the turbine's
+ * acceleration. Without it no engine request (engine_active false). No
+ * adaptation in this type yet; the report's friction energy is both
+ * clutches' (the off-going one does the inertia phase's work), its jerk that
+ * of the output torque T_c + (b1 / b) T_1, tie_up never set (the plant
+ * measures it). */
+#define WC_SHIFT_INERTIA_FIRST_ASSIST 1u  /* the tip-out: a negative hold-back is the on-coming clutch's push */
+#define WC_SHIFT_INERTIA_FIRST_ENGINE 2u  /* the coast downshift: the engine request moves the turbine */
 bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
-                                 const wc_shift_command_t *command, bool safe, bool oncoming_assist, wc_clutch_t *clutch,
+                                 const wc_shift_command_t *command, bool safe, uint32_t options, wc_clutch_t *clutch,
                                  wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
                                  wc_shift_offgoing_t *offgoing);
 

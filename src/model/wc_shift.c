@@ -333,8 +333,8 @@ static void resume(wc_shift_t *shift, const wc_shift_calibration_t *cal, float s
 }
 
 void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                                      bool safe, bool coord, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
-                                      wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing)
+                                      bool safe, bool coord, float torque_min_Nm, float slip_rad_s, float dt_s,
+                                      const wc_clutch_t *clutch, wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing)
 {
     const bool edge = command->request && !shift->last_request;
     shift->last_request = command->request;
@@ -350,7 +350,7 @@ void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
             if (!safe) { shift->second_gear = false; }  /* withdrawn: the VCU takes 1st gear back (DESIGN 14) */
         }
     } else if (edge && (shift->phase == (uint32_t)WC_SHIFT_IDLE)) {
-        if (wc_shift_command_valid(cal, command)) {
+        if (wc_shift_command_valid(cal, command, torque_min_Nm)) {
             const wc_lag_compensation_t lag = wc_lag_compensation(clutch, cal->lag_compensation_time_s);
             const wc_lag_compensation_t off = coord ? wc_lag_compensation(offgoing->clutch,
                                                                           cal->offgoing_lag_compensation_time_s)
@@ -371,7 +371,7 @@ void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
         /* DESIGN 14: the fallback withdrew the engine request: the driver's torque T_t0, not the last
          * estimate, which may still hold the reduction (issue 29 item 7) */
         shift->turbine_torque_Nm = shift->driver_torque_Nm;
-    } else if (follow && wc_shift_in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm)) {
+    } else if (follow && wc_shift_in_closed(command->turbine_torque_Nm, torque_min_Nm, WC_TORQUE_MAX_Nm)) {
         shift->turbine_torque_Nm = command->turbine_torque_Nm;  /* follow the engine's estimate */
     }
     if (resumed) { resume(shift, cal, slip_rad_s, adapt); }
@@ -385,7 +385,7 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
                          wc_adapt_t *adapt, wc_step_input_t *in, const wc_shift_offgoing_t *offgoing)
 {
     const bool coord = coordinated(cal, offgoing);
-    wc_shift_transitions(shift, cal, command, safe, coord, slip_rad_s, dt_s, clutch, adapt, offgoing);
+    wc_shift_transitions(shift, cal, command, safe, coord, 0.0f, slip_rad_s, dt_s, clutch, adapt, offgoing);
 
     in->mode = WC_MODE_OPEN;
     in->torque_request_Nm = 0.0f;
@@ -618,12 +618,12 @@ static WC_NOINLINE bool shift_after(wc_shift_t *shift, const wc_shift_calibratio
  * the VFS gets fill_pulse_current_mA to stroke the piston fast; the model
  * steps at the kiss point meanwhile (request 0), which is what the chamber
  * holds while the piston strokes against its spring. */
-WC_NOINLINE void wc_shift_fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
-                                     float dt_s, wc_step_output_t *out)
+WC_NOINLINE void wc_shift_fill_pulse(const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool filling,
+                                     uint32_t fill_periods, float dt_s, wc_step_output_t *out)
 {
     const wc_calibration_t *c = clutch->model.cal;
-    if ((c == NULL) || (shift->phase != (uint32_t)WC_SHIFT_PREPARE) ||
-        (shift->phase_periods >= wc_shift_periods_of(cal->fill_pulse_time_s, dt_s)) || (cal->fill_pulse_time_s <= 0.0f)) {
+    if ((c == NULL) || !filling || (fill_periods >= wc_shift_periods_of(cal->fill_pulse_time_s, dt_s)) ||
+        (cal->fill_pulse_time_s <= 0.0f)) {
         return;
     }
     const float i = cal->fill_pulse_current_mA;
@@ -667,7 +667,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
     shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
     (void)wc_clutch_step(clutch, in, out);
     if (coord) {  /* DESIGN 14: the fill pulse, the off-going clutch (one clutch step deep), the engine */
-        wc_shift_fill_pulse(shift, cal, clutch, dt_s, out);
+        wc_shift_fill_pulse(cal, clutch, shift->phase == (uint32_t)WC_SHIFT_PREPARE, shift->phase_periods, dt_s, out);
         offgoing_input(shift, cal, safe, out->model.torque_Nm, dt_s, offgoing);
         (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
         engine_request(shift, cal, dt_s, offgoing);

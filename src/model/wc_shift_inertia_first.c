@@ -40,7 +40,8 @@ static float oncoming_carried_Nm(const wc_shift_calibration_t *cal, float turbin
 {
     const float i_t = cal->turbine_inertia_kg_m2;
     const float b = cal->output_ratio;
-    return wc_shift_clamp_torque_Nm((turbine_torque_Nm / i_t) / (1.0f / i_t + b * b / cal->output_inertia_kg_m2));
+    /* a magnitude: after a coast downshift it holds the engine's drag (T_t < 0) */
+    return wc_shift_clamp_torque_Nm(fabsf(turbine_torque_Nm / i_t) / (1.0f / i_t + b * b / cal->output_inertia_kg_m2));
 }
 
 /* Without the on-coming assist only the turbine torque moves the turbine
@@ -61,6 +62,24 @@ static float feasible_time_s(const wc_shift_calibration_t *cal, float target_tim
     return (feasible_s > target_time_s) ? feasible_s : target_time_s;
 }
 
+/* DESIGN 15, the kickdown: the on-coming clutch's fill is timed to arrive at
+ * synchronism. Filled early, it waits at its kiss point with the whole
+ * shift's slip across a closed pack: its drag (eq. 5-8's viscous term at
+ * |slip| ~ 200 rad/s, some 80 N m on the 8HP's 3->2) ties the gearbox up at
+ * the inertia phase's start and the output torque falls (measured: -33 m/s^3).
+ * So it stays open until the reference leaves lead_s = prepare_time_s (the
+ * fill's duration) to the target; then the fill pulse, then the kiss point.
+ * Returns the periods since the fill began (0 before; UINT32_MAX when not in
+ * the inertia phase). With the on-coming assist (the tip-out) it may have to
+ * push from the start: filled in PREPARE, as the torque-first shift. */
+static uint32_t late_fill_periods(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
+{
+    const uint32_t target = wc_shift_periods_of(shift->target_time_s, dt_s);
+    const uint32_t lead = wc_shift_periods_of(cal->prepare_time_s, dt_s);
+    const uint32_t start = (target > lead) ? (target - lead) : 0u;
+    return (shift->phase_periods >= start) ? (shift->phase_periods - start + 1u) : 0u;
+}
+
 /* The smoothstep of the torque phase at its next period (0 .. 1). */
 static float handover_share(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float dt_s)
 {
@@ -72,6 +91,7 @@ static float handover_share(const wc_shift_t *shift, const wc_shift_calibration_
 
 typedef struct {
     float oncoming_Nm;   /* the on-coming clutch's request (WC_MODE_TORQUE) */
+    float engine_Nm;     /* WC_SHIFT_INERTIA_FIRST_ENGINE: the engine request (> 0: more torque) */
     float offgoing_Nm;   /* the off-going clutch's request */
     bool offgoing_locked;  /* hand-back: the off-going clutch at its maximum current */
     bool offgoing_open;
@@ -79,9 +99,9 @@ typedef struct {
 
 /* The phase's law; may change the phase (PREPARE -> INERTIA). */
 static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, float dt_s,
-                                 bool offgoing_saturated, bool oncoming_saturated, bool assist)
+                                 bool offgoing_saturated, bool oncoming_saturated, bool assist, bool engine)
 {
-    requests_t r = { 0.0f, 0.0f, false, true };
+    requests_t r = { 0.0f, 0.0f, 0.0f, false, true };
     const float t_t_Nm = shift->turbine_torque_Nm;
     const uint32_t phase = shift->phase;
     if ((phase == (uint32_t)WC_SHIFT_IDLE) || (phase == (uint32_t)WC_SHIFT_ABORTED)) {
@@ -93,8 +113,9 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         const uint32_t n = wc_shift_periods_of(cal->prepare_time_s, dt_s);
         if (shift->phase_periods < n) {
             const float x = (float)(shift->phase_periods + 1u) / (float)n;
-            const float from_Nm = cal->offgoing_holding_factor * t_t_Nm;
-            const float to_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
+            /* magnitudes: before a coast downshift it holds the engine's drag (T_t < 0) */
+            const float from_Nm = cal->offgoing_holding_factor * fabsf(t_t_Nm);
+            const float to_Nm = (1.0f + cal->offgoing_margin_factor) * fabsf(t_t_Nm);
             r.offgoing_Nm = from_Nm + (to_Nm - from_Nm) * x;
             r.offgoing_open = false;
             return r;
@@ -103,8 +124,10 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
          * the integral takes what the feed-forward does not give of the last request */
         wc_shift_enter(shift, WC_SHIFT_INERTIA);
         shift->start_slip_rad_s = slip_rad_s;
-        if (!assist) { shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, t_t_Nm); }
-        shift->request_Nm = (1.0f + cal->offgoing_margin_factor) * t_t_Nm;
+        /* the torque that moves the turbine: T_t, or with the engine what it may add to the driver's T_t0 */
+        const float moving_Nm = engine ? (shift->driver_torque_Nm + cal->engine_increase_max_Nm) : t_t_Nm;
+        if (!assist) { shift->target_time_s = feasible_time_s(cal, shift->target_time_s, slip_rad_s, moving_Nm); }
+        shift->request_Nm = (1.0f + cal->offgoing_margin_factor) * fabsf(t_t_Nm);
         shift->integral_Nm = shift->request_Nm - cal->feedforward_gain * holdback_feedforward_Nm(cal, holdback_k1(cal), t_t_Nm, 0.0f);
         if (!(slip_rad_s < -cal->min_start_slip_rad_s)) {
             wc_shift_abort(shift, WC_SHIFT_ABORT_NO_SLIP);
@@ -124,10 +147,26 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         const float error = slip_rad_s - reference;
         shift->error_sq_sum += error * error;
         shift->inertia_periods++;
-        const float holdback_Nm = ff_Nm + cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
-        /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist */
+        const float pi_Nm = cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
+        const float holdback_Nm = ff_Nm + pi_Nm;
+        if (engine) {
+            /* the coast downshift: the engine accelerates the turbine on the reference, engine_lead_time_s ahead
+             * (its lag): I_t dref/dt - T_t0; the turbine lagging (PI < 0) asks it for -PI k_1 I_t more (the
+             * turbine torque that a hold-back of PI would take away, DESIGN 15) */
+            float lead_rate_rad_s2;
+            (void)wc_shift_reference_at(shift->start_slip_rad_s, shift->target_time_s,
+                                        elapsed_s + cal->engine_lead_time_s, &lead_rate_rad_s2);
+            const float lagging_Nm = (pi_Nm < 0.0f) ? (-pi_Nm * k_1 * cal->turbine_inertia_kg_m2) : 0.0f;
+            const float want_Nm = cal->turbine_inertia_kg_m2 * lead_rate_rad_s2 - shift->driver_torque_Nm + lagging_Nm;
+            r.engine_Nm = (want_Nm > 0.0f) ? ((want_Nm < cal->engine_increase_max_Nm) ? want_Nm : cal->engine_increase_max_Nm)
+                                           : 0.0f;
+            shift->engine_from_Nm = r.engine_Nm;  /* where the torque phase's ramp-out starts */
+        }
+        /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist (with the
+         * engine: not while the engine is at its limit) */
+        const bool engine_full = engine && !(r.engine_Nm < cal->engine_increase_max_Nm);
         const bool blocked = (offgoing_saturated && (error > 0.0f)) ||
-                             ((error < 0.0f) && (assist ? oncoming_saturated : (holdback_Nm <= 0.0f)));
+                             ((error < 0.0f) && (assist ? oncoming_saturated : (engine ? engine_full : (holdback_Nm <= 0.0f))));
         if (!blocked) {
             const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error * dt_s;
             const float limit = cal->integral_limit_Nm;
@@ -139,7 +178,13 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         const float b = cal->output_ratio;
         const float k_c = 1.0f / cal->turbine_inertia_kg_m2 + b * b / cal->output_inertia_kg_m2;
         r.oncoming_Nm = assist ? (-holdback_Nm * k_1 / k_c) : 0.0f;  /* clamped at 0 by set_input */
-        r.offgoing_open = false;
+        /* the tip-out: once the hold-back is spent (the on-coming clutch pushes), the off-going clutch opens for
+         * good, while the push still ramps in: at its kiss point its drag at the shift's slip would be a tie-up
+         * the push works against, and its release at synchronism a step of the output torque (DESIGN 15) */
+        /* (the coast downshift likewise: once the engine carries the turbine, the off-going clutch's drag at
+         * the shift's slip would push the coasting vehicle, then vanish at synchronism) */
+        if ((assist || engine) && !(holdback_Nm > 0.0f)) { shift->offgoing_released = true; }
+        r.offgoing_open = shift->offgoing_released;
         return r;
     }
     /* TORQUE (the hand-over at synchronism), LOCKED */
@@ -147,15 +192,21 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
     const float x = (phase == (uint32_t)WC_SHIFT_TORQUE) ? handover_share(shift, cal, dt_s) : 1.0f;
     /* the turbine running past synchronism (slip > 0: the off-going clutch lets go while T_t still drives) is
      * taken by the on-coming clutch in closed loop (the torque-first shift's flare correction, DESIGN 14) */
-    const float past_rad_s = (slip_rad_s > 0.0f) ? slip_rad_s : 0.0f;
+    /* (after a coast downshift T_t < 0 drags the turbine back below synchronism: the slip past it is
+     * negative, and the on-coming clutch holds it the same way) */
+    const float past_signed_rad_s = engine ? -slip_rad_s : slip_rad_s;
+    const float past_rad_s = (past_signed_rad_s > 0.0f) ? past_signed_rad_s : 0.0f;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
         const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * past_rad_s * dt_s;
-        shift->flare_integral_Nm = (integral_Nm < t_t_Nm) ? integral_Nm : t_t_Nm;  /* anti-windup: T_t */
+        shift->flare_integral_Nm = (integral_Nm < fabsf(t_t_Nm)) ? integral_Nm : fabsf(t_t_Nm);  /* anti-windup: |T_t| */
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
     }
     r.oncoming_Nm = hold_Nm * x + cal->flare_kp_Nm_per_rad_s * past_rad_s + shift->flare_integral_Nm;
+    r.engine_Nm = (engine && (phase == (uint32_t)WC_SHIFT_TORQUE)) ? (shift->engine_from_Nm * (1.0f - x)) : 0.0f;
     r.offgoing_Nm = shift->phase_start_request_Nm * (1.0f - x);
-    r.offgoing_open = !(x < 1.0f);
+    /* nothing to hand over (the tip-out's hold-back ended at 0: the on-coming clutch pushed): open at once,
+     * not at the kiss point, where its drag at the whole shift's slip ties the gearbox up (DESIGN 15) */
+    r.offgoing_open = !(x < 1.0f) || !(shift->phase_start_request_Nm > 0.0f) || shift->offgoing_released;
     return r;
 }
 
@@ -180,6 +231,12 @@ static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, cons
         /* the on-coming clutch waits at its kiss point: its model does not lock; synchronism ends the phase */
         if (wc_shift_inertia_over(shift, cal, clutch, false, slip_rad_s, dt_s)) {
             shift->phase_start_request_Nm = shift->request_Nm;
+            /* the coast downshift's engine request at synchronism: only what cancels the engine's drag (no net
+             * turbine torque), then ramped out over the hand-over: what the PI added for a lagging turbine would
+             * reach the output through the closing on-coming clutch as a push (measured: +96 N m, 11 m/s^3) */
+            const float drag_Nm = -shift->driver_torque_Nm;
+            const float hold_Nm = (drag_Nm > 0.0f) ? drag_Nm : 0.0f;
+            shift->engine_from_Nm = (shift->engine_from_Nm < hold_Nm) ? shift->engine_from_Nm : hold_Nm;
             shift->second_gear = true;  /* from here the on-coming clutch takes the gear: a lost input finishes */
             wc_shift_enter(shift, WC_SHIFT_TORQUE);
         }
@@ -189,7 +246,7 @@ static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, cons
 }
 
 bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,
-                                 const wc_shift_command_t *command, bool safe, bool oncoming_assist, wc_clutch_t *clutch,
+                                 const wc_shift_command_t *command, bool safe, uint32_t options, wc_clutch_t *clutch,
                                  wc_step_input_t *in, wc_step_output_t *out, wc_shift_report_t *report,
                                  wc_shift_offgoing_t *offgoing)
 {
@@ -210,15 +267,24 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     } else if (!wc_shift_phase_running(shift->phase)) {
         shift->fallback_periods = 0u;
     }
-    wc_shift_transitions(shift, cal, command, safe, true, slip_rad_s, dt_s, clutch, NULL, offgoing);
+    /* the coast downshift's engine drags: a negative T_t is its normal command */
+    const float torque_min_Nm = ((options & WC_SHIFT_INERTIA_FIRST_ENGINE) != 0u) ? -WC_TORQUE_MAX_Nm : 0.0f;
+    wc_shift_transitions(shift, cal, command, safe, true, torque_min_Nm, slip_rad_s, dt_s, clutch, NULL, offgoing);
 
     /* the clutches' inputs: the phase's law; the safe state holds the source gear until the hand-over */
     const bool offgoing_saturated = (offgoing->out->status & WC_STATUS_SATURATED) != 0u;
     const bool oncoming_saturated = (out->status & WC_STATUS_SATURATED) != 0u;  /* last step's outputs */
+    const bool oncoming_assist = (options & WC_SHIFT_INERTIA_FIRST_ASSIST) != 0u;
+    const bool engine = (options & WC_SHIFT_INERTIA_FIRST_ENGINE) != 0u;
     const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated, oncoming_saturated,
-                                        oncoming_assist);
-    const bool on_active = (shift->phase == (uint32_t)WC_SHIFT_PREPARE) || (shift->phase == (uint32_t)WC_SHIFT_INERTIA) ||
-                           (shift->phase == (uint32_t)WC_SHIFT_TORQUE) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED);
+                                        oncoming_assist, engine);
+    /* the on-coming clutch: filled in PREPARE with the assist, else late in the inertia phase (above) */
+    const bool inertia = shift->phase == (uint32_t)WC_SHIFT_INERTIA;
+    const uint32_t fill_periods = (inertia && !oncoming_assist) ? late_fill_periods(shift, cal, dt_s) : 0u;
+    const bool filling = oncoming_assist ? (shift->phase == (uint32_t)WC_SHIFT_PREPARE) : (fill_periods > 0u);
+    const bool on_active = (oncoming_assist && ((shift->phase == (uint32_t)WC_SHIFT_PREPARE) || inertia)) ||
+                           (inertia && (fill_periods > 0u)) || (shift->phase == (uint32_t)WC_SHIFT_TORQUE) ||
+                           (shift->phase == (uint32_t)WC_SHIFT_LOCKED);
     const float carried_on_Nm = oncoming_carried_Nm(cal, shift->turbine_torque_Nm);
     set_input(in, on_active ? WC_MODE_TORQUE : WC_MODE_OPEN, r.oncoming_Nm, carried_on_Nm, &shift->lag_compensation);
     const bool hand_back = (safe && !shift->second_gear) || r.offgoing_locked;
@@ -228,10 +294,12 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) { shift->request_Nm = wc_shift_clamp_torque_Nm(r.offgoing_Nm); }
 
     (void)wc_clutch_step(clutch, in, out);
-    wc_shift_fill_pulse(shift, cal, clutch, dt_s, out);
+    wc_shift_fill_pulse(cal, clutch, filling, oncoming_assist ? shift->phase_periods : (fill_periods - 1u), dt_s, out);
     (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
-    offgoing->engine_active = false;  /* no engine request in this type yet (wc_shift.h) */
-    offgoing->engine_delta_Nm = 0.0f;
+    /* the engine request (the coast downshift); none in the safe state or a fallback */
+    offgoing->engine_active = engine && (r.engine_Nm > 0.0f) && !safe &&
+                              (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
+    offgoing->engine_delta_Nm = offgoing->engine_active ? r.engine_Nm : 0.0f;
 
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
     const uint32_t phase_stepped = shift->phase;

@@ -61,11 +61,12 @@ static inline void wc_shift_set_fallback(wc_shift_t *shift, wc_shift_fallback_t 
 /* A command the controller can start: its target gear, a target time in the
  * calibration's range, a turbine torque in [0, WC_TORQUE_MAX_Nm] (a power-off
  * shift's comes mirrored, wc_transmission.h). */
-static inline bool wc_shift_command_valid(const wc_shift_calibration_t *cal, const wc_shift_command_t *command)
+static inline bool wc_shift_command_valid(const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
+                                          float torque_min_Nm)
 {
     return (command->target_gear == WC_SHIFT_TARGET_GEAR) &&
            wc_shift_in_closed(command->target_inertia_time_s, cal->inertia_time_min_s, cal->inertia_time_max_s) &&
-           wc_shift_in_closed(command->turbine_torque_Nm, 0.0f, WC_TORQUE_MAX_Nm);
+           wc_shift_in_closed(command->turbine_torque_Nm, torque_min_Nm, WC_TORQUE_MAX_Nm);
 }
 
 /* The transitions on the command and the loop's state, before the steps
@@ -74,10 +75,12 @@ static inline bool wc_shift_command_valid(const wc_shift_calibration_t *cal, con
  * (with the coordinator the fallback of DESIGN 14: handed back while the
  * off-going clutch has the gear, !second_gear; else finished on the model,
  * released after fallback_time_s), the input's return (resume), the turbine
- * torque followed from the command. coord: the off-going clutch is ours. */
+ * torque followed from the command. coord: the off-going clutch is ours.
+ * torque_min_Nm: the lowest turbine torque a command may carry (0; the coast
+ * downshift's -WC_TORQUE_MAX_Nm: the engine drags). */
 void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                          bool safe, bool coord, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
-                          wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing);
+                          bool safe, bool coord, float torque_min_Nm, float slip_rad_s, float dt_s,
+                          const wc_clutch_t *clutch, wc_adapt_t *adapt, const wc_shift_offgoing_t *offgoing);
 
 /* The hand-over's end, after the step (both controllers: the torque-first
  * shift's LOCKUP, the inertia-first one's TORQUE): LOCKED once the clutch
@@ -107,10 +110,13 @@ bool wc_shift_inertia_over(wc_shift_t *shift, const wc_shift_calibration_t *cal,
 bool wc_shift_account(wc_shift_t *shift, const wc_shift_calibration_t *cal, uint32_t phase_before, uint32_t phase_stepped,
                       float heat_W, float theta_degC, float output_torque_Nm, float dt_s);
 
-/* The fill pulse (DESIGN 14), after the on-coming clutch's step of a PREPARE
- * period (wc_shift.c). */
-void wc_shift_fill_pulse(const wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch,
-                         float dt_s, wc_step_output_t *out);
+/* The fill pulse (DESIGN 14), after the on-coming clutch's step: while
+ * filling, for fill_pulse_time_s from the fill's start (fill_periods since
+ * then), the current at least fill_pulse_current_mA. The torque-first shift
+ * fills in PREPARE; the inertia-first one late in the inertia phase
+ * (wc_shift_inertia_first.c). */
+void wc_shift_fill_pulse(const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool filling,
+                         uint32_t fill_periods, float dt_s, wc_step_output_t *out);
 
 /* The first-order filtered jerk of a torque (DESIGN 10's quality vector):
  * updates *filtered_Nm and returns |jerk_per_torque_rate x its rate|. */

@@ -119,9 +119,8 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
     tx->refusal = (uint32_t)result;
     if ((result != WC_GEARBOX_SHIFT_OK) || (row == NULL)) { return; }
     tx->type = (uint32_t)wc_gearbox_shift_type(g, row, command->turbine_torque_Nm);
-    const bool power_off = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_UP) ||
-                           (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_DOWN);
-    tx->sign = power_off ? -1.0f : 1.0f;
+    /* mirrored: the tip-out (the kickdown's controller with the speeds and torques negated, DESIGN 15) */
+    tx->sign = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_UP) ? -1.0f : 1.0f;
     (void)wc_gearbox_shift_calibration(config->shift, row, &tx->shift_cal);
     make_equivalent(config->element[row->oncoming], row->oncoming_slip_scale, &tx->equivalent[0]);
     make_equivalent(config->element[row->offgoing], row->offgoing_slip_scale, &tx->equivalent[1]);
@@ -201,13 +200,15 @@ static bool shift_step(wc_transmission_t *tx, const wc_transmission_config_t *co
     const wc_shift_command_t c = { command->request && (command->target_gear == row->target_gear), WC_SHIFT_TARGET_GEAR,
                                    sign * command->turbine_torque_Nm, command->target_inertia_time_s };
     wc_shift_offgoing_t og = { &tx->element[off], &tx->element_in[off], &out->element[off], false, 0.0f };
-    const bool torque_first = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_ON_UP) ||
-                              (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_DOWN);
+    const bool torque_first = tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_ON_UP;
+    /* the tip-out (mirrored) with the on-coming assist, the kickdown without, the coast downshift with the
+     * engine as the inertia phase's actuator (wc_shift.h) */
+    const uint32_t options = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_UP) ? WC_SHIFT_INERTIA_FIRST_ASSIST
+                             : ((tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_DOWN) ? WC_SHIFT_INERTIA_FIRST_ENGINE : 0u);
     const bool ended = torque_first
         ? wc_shift_step(&tx->shift, &tx->shift_cal, &c, safe, &tx->element[on], NULL, &tx->element_in[on],
                         &out->element[on], report, &og)
-        /* the tip-out (mirrored) with the on-coming assist, the kickdown without (wc_shift.h) */
-        : wc_shift_inertia_first_step(&tx->shift, &tx->shift_cal, &c, safe, sign < 0.0f, &tx->element[on],
+        : wc_shift_inertia_first_step(&tx->shift, &tx->shift_cal, &c, safe, options, &tx->element[on],
                                       &tx->element_in[on], &out->element[on], report, &og);
     out->engine_active = og.engine_active;
     out->engine_delta_Nm = sign * og.engine_delta_Nm;  /* back to the real frame */

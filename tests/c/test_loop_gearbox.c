@@ -32,6 +32,7 @@ typedef struct {
     float turbine_rad_s;
     float output_rad_s;
     float turbine_torque_Nm;
+    float engine_Nm;             /* what the engine delivers of the transmission's request (the rig's lag) */
     uint8_t alive_sensors;
     uint8_t alive_command;
     uint8_t alive_element[WC_GEARBOX_ELEMENTS_MAX];  /* the receiver's expectation of each element frame */
@@ -118,7 +119,7 @@ static void rig_step(rig_t *r, bool request, uint32_t current, uint32_t target)
     }
     rig_decode(r);
     wc_test_tx_plant(&wc_gearbox_8hp, &r->loop.transmission, &r->loop.transmission_out, r->turbine_torque_Nm, DT_s,
-                     &r->turbine_rad_s, &r->output_rad_s);
+                     &r->engine_Nm, &r->turbine_rad_s, &r->output_rad_s);
 }
 
 static bool status_bit(const rig_t *r, uint16_t bit) { return (r->status.status & bit) != 0u; }

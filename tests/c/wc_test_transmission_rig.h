@@ -6,7 +6,12 @@
  * model torques in its coordinates, no road load), rigid in a gear; in a
  * shift held at the source (target) gear's ratio while the off-going
  * (on-coming) element's modelled static capacity carries what it must, else
- * both speeds move with T_t and both elements' torques. */
+ * both speeds move with T_t and both elements' torques. The engine follows
+ * the transmission's request with a first-order lag of the shift
+ * calibration's engine_lead_time_s (what the TCU expects; *engine_Nm its
+ * state): T_t = the driver's + what it delivers (the coast downshift's
+ * inertia phase is the engine's work, DESIGN 15); the caller's torque
+ * estimate stays the driver's. */
 #ifndef WC_TEST_TRANSMISSION_RIG_H
 #define WC_TEST_TRANSMISSION_RIG_H
 
@@ -17,12 +22,14 @@
 /* One period of the plant after the transmission's step (its outputs in out). */
 static inline void wc_test_tx_plant(const wc_gearbox_t *g, const wc_transmission_t *tx,
                                     const wc_transmission_output_t *out, float turbine_torque_Nm, float dt_s,
-                                    float *turbine_rad_s, float *output_rad_s)
+                                    float *engine_Nm, float *turbine_rad_s, float *output_rad_s)
 {
+    const float asked_Nm = out->engine_active ? out->engine_delta_Nm : 0.0f;
+    *engine_Nm += (asked_Nm - *engine_Nm) * dt_s / (tx->shift_cal.engine_lead_time_s + dt_s);
     const wc_gearbox_shift_t *row = (tx->row != NULL) ? tx->row : tx->gear_row;
     const float i_t = row->turbine_inertia_kg_m2;
     const float i_out = row->output_inertia_kg_m2;
-    const float t_t = turbine_torque_Nm;
+    const float t_t = turbine_torque_Nm + *engine_Nm;
     if (tx->row == NULL) {  /* in a gear: rigid at its ratio */
         const float ratio = g->ratio[tx->gear];
         *output_rad_s += ratio * t_t / (i_out + i_t * ratio * ratio) * dt_s;

@@ -2,7 +2,8 @@
 29, DESIGN 15): wc_transmission_step in process (ctypes) in lockstep with Plant8, one shift of each type on the
 nominal vehicle. Asserted: the type the firmware picks, completion (AbortReason 0) in the target gear by the
 plant's truth, the inertia phase within its target, the on-coming element's observer within 5 K of its true
-temperature. The comfort targets of issue 29 that these shifts miss today are strict xfails with the figures."""
+temperature, and issue 29's comfort targets (peak jerk by type, flare and sag); a target missed is a strict
+xfail with its figures."""
 import pytest
 
 from wetclutch.shift import transmission8 as t8
@@ -26,26 +27,36 @@ def test_completes_in_the_target_gear(results, case):
     assert q["type"] == case[2]
     assert q["abort"] == 0
     assert q["end_gear"] == str(case[1])
-    # the controller's inertia phase within +-10 % of its target (0.5 s; a kickdown's stretched one is longer:
-    # the engine torque sets its pace, wc_shift.h) and the whole shift within 1.2 s of the request
+    # the controller's inertia phase within +-10 % of its commanded target (transmission8.TARGET_S per type; a
+    # kickdown's is stretched to what the engine torque can do, wc_shift.h: only the lower bound holds) and the
+    # whole shift within 0.7 s more (prepare, the hand-over, the lock-up's dwell)
     assert q["inertia_time_s"] >= 0.9 * q["target_s"]
-    assert q["duration_s"] <= 1.2
+    if case[2] != "power-on downshift":
+        assert q["inertia_time_s"] <= 1.1 * q["target_s"]
+    assert q["duration_s"] <= q["target_s"] + 0.7
 
 
-@pytest.mark.parametrize("case", CASES, ids=[f"{s}-{t} {k}" for s, t, k in CASES])
+OPEN_DRAG = pytest.mark.xfail(strict=True, reason="missed (2026-11-28): the kickdown's on-coming element stays open "
+                              "until its late fill (no drag heat in the plant: 80.1 degC) while the TCU's model of an "
+                              "open element drags with the film at zero contact force (h_bar(0), not the retracted "
+                              "piston's clearance the plant has): estimate 86.1 (3->2) and 86.1 (6->4) degC, 5.8-6.0 K "
+                              "over; the model needs the open clearance (DESIGN 9)")
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=OPEN_DRAG) if c[2] == "power-on downshift" else c
+                                  for c in CASES], ids=[f"{s}-{t} {k}" for s, t, k in CASES])
 def test_observer_within_5_K_of_the_truth(results, case):
     q = results[case]     # issue 31's observer target, on the on-coming element (the one that heats)
     assert abs(q["peak_theta_estimate_degC"] - q["peak_theta_truth_degC"]) <= 5.0
 
 
-@pytest.mark.xfail(strict=True, reason="missed (2026-11-28, nominal vehicle): peak jerk 10.3-15.5 m/s^3 in the "
-                   "tip-outs (target 5), 33-35 in the kickdowns (15), 29 in the coast downshift (5); the coast "
-                   "downshift's turbine sags 45 rpm below the source gear's speed (30): the power-off and down "
-                   "types are untuned (the power-on upshift's calibration, no engine request in the inertia-first "
-                   "types)")
 def test_comfort_targets(results):
+    """Issue 29's comfort targets by type: peak output jerk, and no flare or sag beyond 30 rpm outside the band
+    between the two gears' speeds."""
     limits = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0,
               "power-off downshift": 5.0}
     for case, q in results.items():
+        print(f"{q['shift']} {case[2]}: jerk {q['peak_jerk_m_s3']:.1f} m/s^3 (limit {limits[case[2]]}), excursion "
+              f"{q['excursion_rpm']:.0f} rpm, inertia {q['inertia_time_s']:.3f} s of {q['target_s']} s")
         assert q["peak_jerk_m_s3"] <= limits[case[2]], (case, q["peak_jerk_m_s3"])
         assert q["excursion_rpm"] <= 30.0, (case, q["excursion_rpm"])

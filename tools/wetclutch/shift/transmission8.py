@@ -50,7 +50,11 @@ from .scenarios import ROOT, SHIFT_TOML, ShiftError
 LIBRARY = ROOT / "build" / "host-release" / "src" / "host" / "libwc_transmission_host.so"
 ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
 HOLDING_MARGIN, HOLDING_FLOOR_NM = 1.3, 10.0
-TARGET_S = 0.5
+# The commanded inertia time per type (ShiftCommand.TargetInertiaTime: the integrator's shift schedule): the
+# comfort shifts slower. A tip-out's push (the on-coming clutch pulls the turbine down against the vehicle) gives
+# a jerk of 1 / T^2: 14.9 m/s^3 at 0.5 s, 6.6 at 0.8, 4.7 at 1.2 (2->3, nominal); a coast downshift's is the
+# engine's work, at most engine_increase_max_Nm (60 N m) over its drag: 2 s for a 3->2 at 1300 rpm.
+TARGET_S = {"power-on upshift": 0.5, "power-off upshift": 1.2, "power-on downshift": 0.5, "power-off downshift": 2.0}
 AFTER_S = 0.3                                # run on after the shift's end: the target gear holds
 TYPES = {0: "power-on upshift", 1: "power-off upshift", 2: "power-on downshift", 3: "power-off downshift"}
 # type -> (direction, pedal (None: for the load), turbine rpm at the request)
@@ -142,7 +146,7 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
         w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q) * q * RPM
         w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q) * q * RPM
         torque = st["engine_torque_Nm"] * (1.0 + v.torque_estimate_bias) + v.torque_estimate_noise * z[2]
-        o = tx.step(k >= n_pre, source, target, torque, TARGET_S, w_t, w_o, plant.oil_degC, plant.housing_degC)
+        o = tx.step(k >= n_pre, source, target, torque, TARGET_S[kind], w_t, w_o, plant.oil_degC, plant.housing_degC)
         if k == n_pre:
             if o.refusal != 0:
                 raise ShiftError(f"{src}->{tgt}: refused (wc_gearbox_shift_result_t {o.refusal})")
@@ -184,7 +188,7 @@ def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, 
     theta_est = max(theta_estimate[n_pre:]) if len(theta_estimate) > n_pre else math.nan
     return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort,
             "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
-            "inertia_time_s": inertia, "target_s": TARGET_S,
+            "inertia_time_s": inertia, "target_s": TARGET_S[case["kind"]],
             "peak_jerk_m_s3": float(np.max(np.abs(jerk[sl]), initial=0.0)),
             "excursion_rpm": excursion, "energy_kJ": energy, "oncoming": on,
             "peak_theta_estimate_degC": theta_est,
