@@ -60,3 +60,37 @@ def test_comfort_targets(results):
               f"{q['excursion_rpm']:.0f} rpm, inertia {q['inertia_time_s']:.3f} s of {q['target_s']} s")
         assert q["peak_jerk_m_s3"] <= limits[case[2]], (case, q["peak_jerk_m_s3"])
         assert q["excursion_rpm"] <= 30.0, (case, q["excursion_rpm"])
+
+
+def test_matrix_covers_every_shift_and_type():
+    """Issue 29 item 5's matrix (transmission8 --matrix): every single step up and down in both power-on and
+    power-off, the single-element skips both ways, the power-on types at each load."""
+    cases = t8.matrix_cases(loads=(1.0, 0.25))
+    keys = {(s, t, k) for s, t, k, _ in cases}
+    for g in range(1, 8):
+        assert {(g, g + 1, "power-on upshift"), (g, g + 1, "power-off upshift"), (g + 1, g, "power-on downshift"),
+                (g + 1, g, "power-off downshift")} <= keys
+    for a, b in t8.SKIP_DOWNS:
+        assert {(a, b, "power-on downshift"), (a, b, "power-off downshift"), (b, a, "power-on upshift"),
+                (b, a, "power-off upshift")} <= keys
+    loads = {(s, t, k): set() for s, t, k, _ in cases}
+    for s, t, k, load in cases:
+        loads[(s, t, k)].add(load)
+    assert all(v == ({1.0, 0.25} if k.startswith("power-on") else {0.0}) for (_, _, k), v in loads.items())
+    assert len(cases) == (14 + 12) * 3
+
+
+def test_matrix_names_every_missed_target():
+    good = {"kind": "power-off upshift", "shift": "2->3", "abort": 0, "end_gear": "3", "peak_jerk_m_s3": 4.9,
+            "excursion_rpm": 29.0, "inertia_time_s": 1.19, "target_s": 1.2, "peak_theta_estimate_degC": 84.0,
+            "peak_theta_truth_degC": 80.0}
+    assert t8.missed(good) == []
+    for change, says in (({"abort": 2}, "not completed"), ({"end_gear": "2"}, "not completed"),
+                         ({"peak_jerk_m_s3": 5.1}, "jerk"), ({"excursion_rpm": 31.0}, "flare/sag"),
+                         ({"inertia_time_s": 1.4}, "inertia"), ({"peak_theta_estimate_degC": 85.1}, "theta")):
+        m = t8.missed({**good, **change})
+        assert len(m) == 1 and says in m[0], (change, m)
+    # a kickdown's stretched inertia phase is not a miss (the engine torque sets its pace), a short one is
+    kick = {**good, "kind": "power-on downshift", "peak_jerk_m_s3": 12.0, "inertia_time_s": 0.9, "target_s": 0.5}
+    assert t8.missed(kick) == []
+    assert "inertia" in t8.missed({**kick, "inertia_time_s": 0.4})[0]

@@ -200,11 +200,111 @@ CASES = ((2, 3, "power-on upshift"), (2, 3, "power-off upshift"), (3, 2, "power-
          (6, 4, "power-on downshift"), (4, 6, "power-off upshift"))
 
 
+LIMITS_JERK = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0,
+               "power-off downshift": 5.0}      # issue 29: peak output jerk by type, m/s^3
+EXCURSION_RPM, THETA_K, INERTIA_TOLERANCE = 30.0, 5.0, 0.10
+SKIP_DOWNS = ((8, 6), (7, 5), (6, 4), (5, 3), (4, 2), (3, 1))   # DESIGN 15's single-element skips
+
+
+def matrix_cases(loads=(1.0, 0.25)) -> list[tuple]:
+    """(source, target, type, load): every single step in the four types and the single-element skips (down:
+    kickdown and coast; up: tip-out and power-on), the power-on types at each load."""
+    steps = [(g, g + 1) for g in range(1, 8)] + [(g + 1, g) for g in range(1, 8)]
+    skips = list(SKIP_DOWNS) + [(b, a) for a, b in SKIP_DOWNS]
+    out = []
+    for s, t in steps + skips:
+        up = t > s
+        for kind in (("power-on upshift", "power-off upshift") if up else ("power-on downshift", "power-off downshift")):
+            for load in (loads if kind.startswith("power-on") else (0.0,)):
+                out.append((s, t, kind, load))
+    return out
+
+
+def missed(q: dict) -> list[str]:
+    """The issue-29 targets a shift's quality misses (empty: all met)."""
+    m = []
+    if q.get("error"):
+        return [q["error"]]
+    kind = q["kind"]
+    if q["abort"] != 0 or q["end_gear"] != q["shift"].split("->")[1]:
+        m.append(f"not completed (abort {q['abort']}, end gear {q['end_gear']})")
+    if q["peak_jerk_m_s3"] > LIMITS_JERK[kind]:
+        m.append(f"jerk {q['peak_jerk_m_s3']:.1f} > {LIMITS_JERK[kind]:g}")
+    if q["excursion_rpm"] > EXCURSION_RPM:
+        m.append(f"flare/sag {q['excursion_rpm']:.0f} rpm")
+    stretched = kind == "power-on downshift"       # the engine torque sets a kickdown's pace (wc_shift.h)
+    if math.isfinite(q["inertia_time_s"]) and (q["inertia_time_s"] < (1 - INERTIA_TOLERANCE) * q["target_s"] or (
+            not stretched and q["inertia_time_s"] > (1 + INERTIA_TOLERANCE) * q["target_s"])):
+        m.append(f"inertia {q['inertia_time_s']:.2f} s of {q['target_s']} s")
+    if abs(q["peak_theta_estimate_degC"] - q["peak_theta_truth_degC"]) > THETA_K:
+        m.append(f"theta est - truth {q['peak_theta_estimate_degC'] - q['peak_theta_truth_degC']:+.1f} K")
+    return m
+
+
+def _matrix_job(job):
+    vehicle, source, target, kind, load, oil = job
+    try:
+        q = run_shift(vehicle, source, target, kind, load=load if kind.startswith("power-on") else 1.0, oil_degC=oil)
+    except ShiftError as e:
+        q = {"vehicle": vehicle, "kind": kind, "load": load, "oil_degC": oil, "shift": f"{source}->{target}",
+             "error": f"not run: {e}"}
+    q["load"] = load
+    q["missed"] = missed(q)
+    return q
+
+
+def matrix_report(results: list[dict]) -> str:
+    """The matrix as markdown: one table per vehicle and oil temperature, the misses counted."""
+    lines = []
+    for key in dict.fromkeys((q["vehicle"], q["oil_degC"]) for q in results):
+        rows = [q for q in results if (q["vehicle"], q["oil_degC"]) == key]
+        ok = sum(not q["missed"] for q in rows)
+        lines += [f"### {key[0]}, oil {key[1]:g} degC: {ok} of {len(rows)} meet every target", "",
+                  "| shift | type | load | jerk m/s^3 | flare/sag rpm | inertia s (target) | theta est / truth degC |"
+                  " energy kJ (on-coming) | missed |", "|---|---|---|---|---|---|---|---|---|"]
+        for q in rows:
+            if q.get("error"):
+                lines.append(f"| {q['shift']} | {q['kind']} | {q['load']:g} | | | | | | {q['error']} |")
+                continue
+            lines.append(f"| {q['shift']} | {q['kind']} | {q['load']:g} | {q['peak_jerk_m_s3']:.1f} | "
+                         f"{q['excursion_rpm']:.0f} | {q['inertia_time_s']:.2f} ({q['target_s']}) | "
+                         f"{q['peak_theta_estimate_degC']:.1f} / {q['peak_theta_truth_degC']:.1f} | "
+                         f"{q['energy_kJ'][q['oncoming']]:.2f} | {'; '.join(q['missed']) or '-'} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def run_matrix(out: Path, vehicles, oils, loads, processes: int = 2) -> int:
+    """Run the matrix (matrix_cases on each vehicle and oil), write OUT/matrix.md and OUT/matrix.json; 1 when a
+    shift misses a target."""
+    from multiprocessing import Pool
+    from ..util.atomic import Staged
+    jobs = [(v, s, t, k, load, oil) for v in vehicles for oil in oils for s, t, k, load in matrix_cases(loads)]
+    with Pool(processes) as pool:
+        results = pool.map(_matrix_job, jobs)
+    report = matrix_report(results)
+    out.mkdir(parents=True, exist_ok=True)
+    with Staged() as staged:   # both or neither
+        staged.write_text(out / "matrix.md", report + "\n")
+        staged.write_text(out / "matrix.json", json.dumps(results, indent=1, default=float))
+    print(report)
+    bad = [q for q in results if q["missed"]]
+    print(f"transmission8: {len(results) - len(bad)} of {len(results)} shifts meet every target; report in {out}")
+    return 1 if bad else 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m wetclutch.shift.transmission8", description=__doc__.split("\n")[0])
     ap.add_argument("--vehicle", default="nominal", help="a vehicle of tools/plants/8hp or an 8-speed plant file")
-    ap.add_argument("--out", type=Path, help="write the figures as JSON here")
+    ap.add_argument("--out", type=Path, help="write the figures as JSON here (with --matrix: the report's folder)")
+    ap.add_argument("--matrix", action="store_true", help="issue 29's matrix: every single step and skip in the four"
+                    " types on --vehicles at --oil and --loads; exit 1 when a shift misses a target")
+    ap.add_argument("--vehicles", nargs="+", default=["nominal", "heavy", "light"], help="with --matrix")
+    ap.add_argument("--oil", nargs="+", type=float, default=[OIL_DEGC], help="with --matrix: oil temperatures, degC")
+    ap.add_argument("--loads", nargs="+", type=float, default=[1.0, 0.25], help="with --matrix: power-on loads")
     args = ap.parse_args(argv)
+    if args.matrix:
+        return run_matrix(args.out or Path("out/transmission8"), args.vehicles, args.oil, args.loads)
     results = []
     for source, target, kind in CASES:
         try:
