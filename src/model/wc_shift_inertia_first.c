@@ -225,11 +225,20 @@ static void set_input(wc_step_input_t *in, wc_clutch_mode_t mode, float request_
 /* After the steps: the inertia phase's end (synchronism: the torque phase),
  * the hand-over's end (LOCKED, or AbortReason 2). */
 static void phase_end(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_clutch_t *clutch, bool locked,
-                      float slip_rad_s, float dt_s)
+                      float slip_rad_s, float dt_s, bool off_driven)
 {
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) {
-        /* the on-coming clutch waits at its kiss point: its model does not lock; synchronism ends the phase */
-        if (wc_shift_inertia_over(shift, cal, clutch, false, slip_rad_s, dt_s)) {
+        /* the on-coming clutch waits at its kiss point: its model does not lock; synchronism ends the phase,
+         * also when the slip runs through it without a dwell in the lock band (a tip-out's turbine, pulled down
+         * by the engine's drag, goes on below the target gear's speed: the torque phase's correction of the
+         * slip past synchronism takes it; measured on the 8HP's 1->2: through 0 at 1.3 s, then a 300 rpm sag
+         * and an inertia timeout). Only where the off-going clutch no longer drives the slip (off_driven false:
+         * the tip-out's push, the coast's engine): in a kickdown its hold-back pulls an overshoot back (on the
+         * 4->3 ending at the crossing flared 33 rpm) */
+        const bool crossed = !off_driven && !(slip_rad_s < 0.0f) &&
+                             (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
+        if (crossed) { shift->report.inertia_time_s = (float)(shift->phase_periods + 1u) * dt_s; }
+        if (crossed || wc_shift_inertia_over(shift, cal, clutch, false, slip_rad_s, dt_s)) {
             shift->phase_start_request_Nm = shift->request_Nm;
             /* the coast downshift's engine request at synchronism: only what cancels the engine's drag (no net
              * turbine torque), then ramped out over the hand-over: what the PI added for a lagging turbine would
@@ -303,7 +312,7 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
 
     const bool locked = (out->status & WC_STATUS_LOCKED) != 0u;
     const uint32_t phase_stepped = shift->phase;
-    phase_end(shift, cal, clutch, locked, slip_rad_s, dt_s);
+    phase_end(shift, cal, clutch, locked, slip_rad_s, dt_s, options == 0u);
 
     /* the quality vector: both clutches' heat (eq. 1), the output torque T_c + (b1 / b) T_1's jerk */
     const float heat_W = fabsf(out->model.torque_Nm * slip_rad_s) + fabsf(offgoing->out->model.torque_Nm * shift->offgoing_slip_rad_s);
