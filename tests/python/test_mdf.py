@@ -16,7 +16,12 @@ from wetclutch.util import canlog, mdf
 
 # The DBC's enumerations (value names for every raw value of the valid range): stored with a value-to-text
 # conversion. The other value names (SNA) make a status-string table: the name reads as NaN.
-ENUMS = {"Mode", "LockState", "AbortReason", "Fallback"}
+# The DBC's enumerations (a value table naming every raw value of the range, no scaling: Mode, LockState,
+# AbortReason, Fallback, the transmission's ShiftType, Refusal, Role, Locked), read from the DBC itself.
+ENUMS = {s.name for m in canlog.database().messages for s in m.signals
+         if s.choices and s.scale == 1 and s.offset == 0 and s.minimum is not None
+         and all(v in s.choices for v in range(int(s.minimum), int(s.maximum) + 1))}
+assert {"Mode", "LockState", "AbortReason", "Fallback", "ShiftType", "Refusal", "Role", "Locked"} <= ENUMS
 
 
 def assert_matches_dbc(path, messages) -> dict:
