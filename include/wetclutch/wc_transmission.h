@@ -26,10 +26,10 @@
  * During a shift the two elements it keeps closed are held at their maximum
  * current (they carry the slipping elements' reactions and the inertia
  * torques besides T_t's share: not bounded by T_t).
- * In a gear every closed element's slip is the gear's slip w_t - ratio w_o
- * (turbine and output speed tell that the box slips, not which element; a
- * slip shows on all three), an open element's its own (a w_t - b w_o of a
- * shift from the gear: its drag heats it). The safe state (the caller's, or a
+ * In a gear the closed elements are held at the inverse at zero slip (a
+ * gear slip, w_t - ratio w_o, tells that the box slips, not which element:
+ * debounced, it holds them at the maximum current, below), an open element's
+ * slip is its own (a w_t - b w_o of a shift from the gear: its drag heats it). The safe state (the caller's, or a
  * speed not valid) holds the closed elements at their maximum current (the
  * gear kept without inputs); a shift's own fallback is wc_shift.h's.
  * After a shift the elements hold the target gear when it completed or the
@@ -108,7 +108,17 @@ typedef struct {
     uint64_t runnable;                   /* bit i: shift i's equivalent clutches are within the limits */
     float sign;                          /* 1, or -1: a power-off shift, mirrored */
     bool last_request;
+    uint32_t gear_slip_periods;          /* consecutive periods of a gear slip beyond WC_TRANSMISSION_GEAR_SLIP_rad_s */
+    bool gear_slipped;                   /* latched until the next shift: the gear held at the maximum current */
 } wc_transmission_t;
+
+/* In a gear the closed elements are held at the inverse at zero slip; a gear
+ * slip (turbine - ratio x output) beyond 5 rpm (issue 29's in-gear limit) for
+ * WC_TRANSMISSION_GEAR_SLIP_PERIODS in a row (a slipping element, or a speed
+ * sensor stuck at a plausible value) holds them at the maximum current until
+ * the next shift: the holding never falls with the slip. */
+#define WC_TRANSMISSION_GEAR_SLIP_rad_s 0.52f
+#define WC_TRANSMISSION_GEAR_SLIP_PERIODS 20u
 
 /* Check the configuration (the gearbox, every element, the shift calibration
  * with every shift's reduced model, the holding) and start in gear at

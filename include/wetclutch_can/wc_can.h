@@ -628,7 +628,7 @@ struct wc_can_shift_command_t {
     uint16_t target_inertia_time;
 
     /**
-     * The gear the integrator believes engaged (0 reverse, 1..8 forward). Used only by the transmission (wc_loop with config.transmission, DESIGN 15): a shift request whose CurrentGear is not the gear the elements hold is refused (GearboxStatus.Refusal 6). Ignored by the single-clutch paths (sent as 0 by their logs).
+     * The gear the integrator believes engaged (0 reverse, 1..8 forward). Used only by the transmission (wc_loop with config.transmission, DESIGN 15): a shift request whose CurrentGear is not the gear the elements hold is refused (GearboxStatus.Refusal 6). Not used by the single-clutch paths (their logs send 0); like every signal it must lie in its range (0..8), else the frame is implausible.
      *
      * Range: 0..8 (0..8 -)
      * Scale: 1
@@ -1321,7 +1321,7 @@ struct wc_can_gearbox_status_t {
     uint8_t shift_type;
 
     /**
-     * Why the last request's rising edge started no shift (include/wetclutch/wc_gearbox.h): 0 accepted, 1 same gear, 2 no such gear, 3 a swap of two elements, 4 to or from reverse, 5 not in the table, 6 CurrentGear is not the held gear, 7 busy (a shift runs or the safe state), 8 no model for this shift.
+     * Why the last request's rising edge started no shift (include/wetclutch/wc_gearbox.h): 0 accepted, 1 same gear, 2 no such gear, 3 a swap of two elements, 4 to or from reverse, 5 not in the table, 6 CurrentGear is not the held gear, 7 busy (the safe state; a new target during a shift cancels it instead), 8 no model for this shift.
      *
      * Range: 0..8 (0..8 -)
      * Scale: 1

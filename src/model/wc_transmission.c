@@ -128,6 +128,8 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
     wc_model_set_geometry(&tx->element[row->offgoing].model, &tx->equivalent[1]);
     wc_shift_init(&tx->shift);
     tx->row = row;
+    tx->gear_slip_periods = 0u;  /* a new gear: its slip watched afresh */
+    tx->gear_slipped = false;
 }
 
 /* A closed element's input in a gear: the inverse of what it must carry plus
@@ -149,17 +151,24 @@ static float element_slip(const wc_gearbox_shift_t *row, uint32_t e, float w_t, 
     return (valid && (row != NULL)) ? wc_gearbox_element_slip_rad_s(row, e, w_t, w_o) : NAN;
 }
 
-/* In a gear: the closed elements held at the gear's slip, the open ones open at their own. */
+/* In a gear: the closed elements held at the inverse at zero slip (DESIGN 15; at their maximum in the safe
+ * state or once the gear slipped, WC_TRANSMISSION_GEAR_SLIP_rad_s), the open ones open at their own slip. */
 static void hold_gear(wc_transmission_t *tx, const wc_transmission_config_t *config,
                       const wc_transmission_command_t *command, float w_t, float w_o, bool valid, bool safe)
 {
     const wc_gearbox_t *g = config->gearbox;
-    const float gear_slip_rad_s = valid ? (w_t - g->ratio[tx->gear] * w_o) : NAN;
+    const float gear_slip_rad_s = valid ? (w_t - g->ratio[tx->gear] * w_o) : 0.0f;
+    /* the review's finding: held at the measured slip, the inverse's current fell as the gear slipped (-35 %
+     * with the output speed stuck at 0); now at zero slip, and a slip that lasts holds at the maximum */
+    const bool slipping = fabsf(gear_slip_rad_s) > WC_TRANSMISSION_GEAR_SLIP_rad_s;
+    tx->gear_slip_periods = slipping ? ((tx->gear_slip_periods < UINT32_MAX) ? (tx->gear_slip_periods + 1u) : UINT32_MAX)
+                                     : 0u;
+    if (tx->gear_slip_periods >= WC_TRANSMISSION_GEAR_SLIP_PERIODS) { tx->gear_slipped = true; }
     for (uint32_t e = 0u; e < g->element_count; ++e) {
         wc_step_input_t *in = &tx->element_in[e];
         if (((g->closed_mask[tx->gear] >> e) & 1u) != 0u) {
-            hold(in, config, tx->gear, e, command->turbine_torque_Nm, safe);
-            in->slip_rad_s = gear_slip_rad_s;
+            hold(in, config, tx->gear, e, command->turbine_torque_Nm, safe || tx->gear_slipped);
+            in->slip_rad_s = valid ? 0.0f : NAN;
         } else {
             in->mode = WC_MODE_OPEN;
             in->slip_rad_s = element_slip(tx->gear_row, e, w_t, w_o, valid);
@@ -265,6 +274,9 @@ bool wc_transmission_step(wc_transmission_t *tx, const wc_transmission_config_t 
     out->engine_active = false;
     out->engine_delta_Nm = 0.0f;
     if (tx->row != NULL) {
+        const uint32_t on = tx->row->oncoming;
+        const float on_before_mA = out->element[on].current_mA;   /* out holds the last step's (the contract) */
+        const float on_before_Pa = out->element[on].pressure_command_Pa;
         ended = shift_step(tx, config, command, w_t, w_o, valid, safe, out, report);
         phase = tx->shift.phase;
         for (uint32_t e = 0u; e < g->element_count; ++e) {  /* the shift stepped its two */
@@ -272,7 +284,18 @@ bool wc_transmission_step(wc_transmission_t *tx, const wc_transmission_config_t 
                 (void)wc_clutch_step(&tx->element[e], &tx->element_in[e], &out->element[e]);
             }
         }
-        if (ended) { end_shift(tx, config); }
+        if (ended) {
+            const bool aborted = tx->shift.phase == (uint32_t)WC_SHIFT_ABORTED;
+            end_shift(tx, config);
+            /* an aborted shift whose on-coming element had taken the gear ends with the controller's release
+             * of it; the gear is kept, so it keeps its last command for this period (the review's finding:
+             * 135 -> 0 -> 1000 mA), and the gear's hold takes it from the next */
+            if (aborted && (((g->closed_mask[tx->gear] >> on) & 1u) != 0u) &&
+                (out->element[on].current_mA < on_before_mA)) {
+                out->element[on].current_mA = on_before_mA;
+                out->element[on].pressure_command_Pa = on_before_Pa;
+            }
+        }
     } else {
         hold_gear(tx, config, command, w_t, w_o, valid, safe);
         for (uint32_t e = 0u; e < g->element_count; ++e) {

@@ -1,6 +1,6 @@
 """The transmission through its CAN frames (issue 29 item 3; wetclutch.shift.transmission_frames): the frame
-loop with config.transmission in process (wc_replay --gearbox 8hp --lockstep) in closed loop with the 8-speed
-plant, every shift type; its frames checked (E2E, counters, roles, the status), and its shifts against the same
+loop with config.transmission in process (libwc_transmission_host's frames mode, through ctypes) in closed loop
+with the 8-speed plant, every shift type; its frames checked (E2E, counters, roles, the status), and its shifts against the same
 shifts with wc_transmission_step called directly (transmission8's ctypes path): the frames add only the DBC's
 quantisation, so the shifts agree to what that quantisation explains."""
 from __future__ import annotations
