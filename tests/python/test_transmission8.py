@@ -2,8 +2,8 @@
 29, DESIGN 15): wc_transmission_step in process (ctypes) in lockstep with Plant8, one shift of each type on the
 nominal vehicle. Asserted: the type the firmware picks, completion (AbortReason 0) in the target gear by the
 plant's truth, the inertia phase within its target, the on-coming element's observer within 5 K of its true
-temperature, and issue 29's comfort targets (peak jerk by type, flare and sag); a target missed is a strict
-xfail with its figures."""
+temperature, issue 29's comfort targets (peak jerk by type, flare and sag) and the kickdown's new gear's speed
+within 0.6 s; a target missed is a strict xfail with its figures."""
 import pytest
 
 from wetclutch.shift import transmission8 as t8
@@ -50,16 +50,43 @@ def test_observer_within_5_K_of_the_truth(results, case):
     assert abs(q["peak_theta_estimate_degC"] - q["peak_theta_truth_degC"]) <= 5.0
 
 
-def test_comfort_targets(results):
+LIMITS = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0, "power-off downshift": 5.0}
+JERK_MISSED = {(4, 6, "power-off upshift"): pytest.mark.xfail(
+    strict=True, reason="missed (2026-11-28): the 4->6 tip-out's peak jerk 5.6 m/s^3 (limit 5; 4.1 before the tip-out "
+    "filled its on-coming element without the fill pulse, which cut the matrix's tip-outs from 3.8-22.1 to 2.4-10.9 m/s^3): "
+    "the off-going element's release at the push's start, 40 N m of output torque in 40 ms at 0.15 s")}
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=JERK_MISSED[c]) if c in JERK_MISSED else c for c in CASES],
+                         ids=[f"{s}-{t} {k}" for s, t, k in CASES])
+def test_comfort_targets(results, case):
     """Issue 29's comfort targets by type: peak output jerk, and no flare or sag beyond 30 rpm outside the band
     between the two gears' speeds."""
-    limits = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0,
-              "power-off downshift": 5.0}
-    for case, q in results.items():
-        print(f"{q['shift']} {case[2]}: jerk {q['peak_jerk_m_s3']:.1f} m/s^3 (limit {limits[case[2]]}), excursion "
-              f"{q['excursion_rpm']:.0f} rpm, inertia {q['inertia_time_s']:.3f} s of {q['target_s']} s")
-        assert q["peak_jerk_m_s3"] <= limits[case[2]], (case, q["peak_jerk_m_s3"])
-        assert q["excursion_rpm"] <= 30.0, (case, q["excursion_rpm"])
+    q = results[case]
+    print(f"{q['shift']} {case[2]}: jerk {q['peak_jerk_m_s3']:.1f} m/s^3 (limit {LIMITS[case[2]]}), excursion "
+          f"{q['excursion_rpm']:.0f} rpm, inertia {q['inertia_time_s']:.3f} s of {q['target_s']} s, new gear's speed "
+          f"at {q['new_speed_s']:.3f} s")
+    assert q["peak_jerk_m_s3"] <= LIMITS[case[2]], (case, q["peak_jerk_m_s3"])
+    assert q["excursion_rpm"] <= 30.0, (case, q["excursion_rpm"])
+
+
+KICKDOWNS = [c for c in CASES if c[2] == "power-on downshift"]
+SLOW_KICKDOWN = pytest.mark.xfail(
+    strict=True, reason="missed (2026-11-28): the 3->2 kickdown's turbine at the 2nd gear's speed 0.625 s after the "
+    "request (0.6 s; was 0.70-0.76 s): its inertia phase is stretched to the trapezoid the engine's full-load torque and "
+    "the 12 m/s^3 design jerk allow (0.658 s from 0.05 s): T_t / I_t = 250 / 0.98 rad/s^2 at the 3->2's 98 rad/s of "
+    "slip; a faster ramp (0.637 s) flared 31 rpm at synchronism, a higher flat rate 14-15 m/s^3. The converter's lock-up "
+    "stays closed: the engine's inertia turns with the turbine")
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW_KICKDOWN) if c[:2] == (3, 2) else c for c in KICKDOWNS],
+                         ids=[f"{s}-{t}" for s, t, _ in KICKDOWNS])
+def test_kickdown_reaches_the_new_gear_in_time(results, case):
+    """Issue 29: a kickdown's turbine at the new gear's speed within 0.6 s of the request at full load (the first
+    period within END_RATIO_TOLERANCE of the target ratio by the plant's truth)."""
+    q = results[case]
+    print(f"{q['shift']}: new gear's speed at {q['new_speed_s']:.3f} s")
+    assert q["new_speed_s"] <= t8.KICKDOWN_NEW_SPEED_S
 
 
 def test_matrix_covers_every_shift_and_type():
@@ -94,3 +121,9 @@ def test_matrix_names_every_missed_target():
     kick = {**good, "kind": "power-on downshift", "peak_jerk_m_s3": 12.0, "inertia_time_s": 0.9, "target_s": 0.5}
     assert t8.missed(kick) == []
     assert "inertia" in t8.missed({**kick, "inertia_time_s": 0.4})[0]
+    # a kickdown at full load reaches the new gear's speed within 0.6 s (never: NaN, a miss); at 25 % load no bound
+    assert t8.missed({**kick, "new_speed_s": 0.58}) == []
+    for late in (0.65, float("nan")):
+        m = t8.missed({**kick, "new_speed_s": late})
+        assert len(m) == 1 and "new gear's speed" in m[0], (late, m)
+    assert t8.missed({**kick, "new_speed_s": 0.65, "load": 0.25}) == []

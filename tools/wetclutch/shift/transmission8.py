@@ -25,6 +25,8 @@ Quality (from the plant's truth): completed (AbortReason 0) and the end gear by 
 locked, the speed ratio the gear's within 0.5 %); the peak vehicle jerk (as quality.py: the acceleration
 low-passed at JERK_CUTOFF_HZ, then its rate) from the request to 0.2 s after the end; the turbine's excursion outside the band between the two gears' speeds (flare above the
 higher, sag below the lower), rpm; the inertia time (the controller's report) against the commanded target;
+the time from the request to the turbine at the new gear's speed (within END_RATIO_TOLERANCE, new_speed_s: a
+kickdown's at full load within KICKDOWN_NEW_SPEED_S);
 per element its friction energy; the on-coming element's peak temperature, estimate and truth. Tie-up is not
 measured here yet.
 """
@@ -186,9 +188,15 @@ def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, 
     inertia = float(report[0]) if report else math.nan
     energy = {e: float(truth[f"{e}_energy_J"][-1] - truth[f"{e}_energy_J"][n_pre]) * 1e-3 for e in ELEMENTS}
     theta_est = max(theta_estimate[n_pre:]) if len(theta_estimate) > n_pre else math.nan
+    # the turbine at the new gear's speed (issue 29's kickdown target: within 0.6 s of the request at full load):
+    # the first period after the request with the true turbine speed within END_RATIO_TOLERANCE of ratio_tgt x
+    # the output speed
+    w_t_all, w_o_all = truth["turbine_speed_rpm"][n_pre + 1:], truth["output_speed_rpm"][n_pre + 1:]
+    at_new = np.nonzero(np.abs(w_t_all - ratio_tgt * w_o_all) <= END_RATIO_TOLERANCE * ratio_tgt * w_o_all)[0]
+    new_speed_s = float(at_new[0] + 1) * dt if at_new.size else math.nan
     return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort,
             "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
-            "inertia_time_s": inertia, "target_s": TARGET_S[case["kind"]],
+            "inertia_time_s": inertia, "target_s": TARGET_S[case["kind"]], "new_speed_s": new_speed_s,
             "peak_jerk_m_s3": float(np.max(np.abs(jerk[sl]), initial=0.0)),
             "excursion_rpm": excursion, "energy_kJ": energy, "oncoming": on,
             "peak_theta_estimate_degC": theta_est,
@@ -203,6 +211,7 @@ CASES = ((2, 3, "power-on upshift"), (2, 3, "power-off upshift"), (3, 2, "power-
 LIMITS_JERK = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0,
                "power-off downshift": 5.0}      # issue 29: peak output jerk by type, m/s^3
 EXCURSION_RPM, THETA_K, INERTIA_TOLERANCE = 30.0, 5.0, 0.10
+KICKDOWN_NEW_SPEED_S = 0.6       # issue 29: a kickdown's turbine at the new gear's speed within 0.6 s at full load
 SKIP_DOWNS = ((8, 6), (7, 5), (6, 4), (5, 3), (4, 2), (3, 1))   # DESIGN 15's single-element skips
 
 
@@ -236,6 +245,8 @@ def missed(q: dict) -> list[str]:
     if math.isfinite(q["inertia_time_s"]) and (q["inertia_time_s"] < (1 - INERTIA_TOLERANCE) * q["target_s"] or (
             not stretched and q["inertia_time_s"] > (1 + INERTIA_TOLERANCE) * q["target_s"])):
         m.append(f"inertia {q['inertia_time_s']:.2f} s of {q['target_s']} s")
+    if stretched and q.get("load", 1.0) >= 1.0 and "new_speed_s" in q and not q["new_speed_s"] <= KICKDOWN_NEW_SPEED_S:
+        m.append(f"new gear's speed at {q['new_speed_s']:.2f} s (> {KICKDOWN_NEW_SPEED_S} s)")   # NaN: never
     if abs(q["peak_theta_estimate_degC"] - q["peak_theta_truth_degC"]) > THETA_K:
         m.append(f"theta est - truth {q['peak_theta_estimate_degC'] - q['peak_theta_truth_degC']:+.1f} K")
     return m
@@ -314,7 +325,8 @@ def main(argv=None) -> int:
             return 2
         results.append(q)
         print(f"{q['shift']:>5} {kind:20s} type {q['type']:20s} abort {q['abort']:2d} end gear {q['end_gear']} "
-              f"duration {q['duration_s']:.3f} s inertia {q['inertia_time_s']:.3f} s jerk {q['peak_jerk_m_s3']:6.1f} "
+              f"duration {q['duration_s']:.3f} s inertia {q['inertia_time_s']:.3f} s new speed {q['new_speed_s']:.3f} s "
+              f"jerk {q['peak_jerk_m_s3']:6.1f} "
               f"excursion {q['excursion_rpm']:5.0f} rpm theta est/true {q['peak_theta_estimate_degC']:.1f}/"
               f"{q['peak_theta_truth_degC']:.1f}")
     if args.out:
