@@ -61,6 +61,7 @@
 
 const wc_calibration_t *const cal = &wc_table1_calibration;
 bool verbose;
+run_stats_t stats;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -101,10 +102,11 @@ static void build_frame(harness_t *h, fz_reader_t *r, uint8_t c, wc_can_frame_t 
         const wc_can_offgoing_sensors_phys_t o = { map_u16(fz_u16(r), -8000.0f, 8000.0f), 0u };
         (void)wc_can_encode_offgoing_sensors(f->data, &o, sizeof f->data);
     } else if (h->plausible && (fault != 3u) && shift) {
+        /* CurrentGear 0: the single-clutch paths ignore it (their logs send 0) */
         const wc_can_shift_command_phys_t s = {
             (float)(fz_u8(r) & 1u), (float)(fz_u8(r) & 1u) /* AdaptationReset */, (float)(fz_u8(r) % 8u + 1u),
             map_u16(fz_u16(r), -1000.0f, 1000.0f),
-            map_u16(fz_u16(r), 50.0f, 2000.0f), 0u };
+            map_u16(fz_u16(r), 50.0f, 2000.0f), 0.0f /* CurrentGear */, 0u };
         (void)wc_can_encode_shift_command(f->data, &s, sizeof f->data);
     } else if (h->plausible && (fault != 3u) && (sensors || request || bench)) {
         if (sensors) {
@@ -171,6 +173,7 @@ void iterate(harness_t *h, const wc_can_frame_t *frame, bool tick, unsigned reco
             FZ_CHECK(!wc_can_is_error(rq), "ShiftReport does not decode cleanly (result %d)", (int)rq);
             h->reports++;
             h->last_abort = q.abort_reason;
+            stats.reports += stats.counting ? 1u : 0u;
         } else {
             FZ_CHECK(adaptive && (out[i].id == WC_CAN_ADAPTATION_REPORT_FRAME_ID), "frame %u id 0x%x", (unsigned)i,
                      (unsigned)out[i].id);
@@ -305,12 +308,35 @@ void start_fresh(harness_t *h, uint8_t options, uint8_t shift_options, float the
 }
 
 
+/* At exit: what the run executed (run_stats_t), one line that scripts/fuzz.sh prints. */
+static void report_stats(void)
+{
+    static const char *const kinds[KINDS] = { "plain", "shift", "whole from init", "whole from a snapshot", "XCP",
+                                              "UDS" };
+    unsigned long inputs = 0u;
+    unsigned long steps = 0u;
+    for (unsigned k = 0u; k < (unsigned)KINDS; ++k) {
+        inputs += stats.inputs[k];
+        steps += stats.steps[k];
+    }
+    fprintf(stderr, "fuzz_loop: %lu inputs, %lu loop steps (%.0f per input, at most %lu); inputs/steps by kind:", inputs,
+            steps, (inputs > 0u) ? (double)steps / (double)inputs : 0.0, stats.steps_max);
+    for (unsigned k = 0u; k < (unsigned)KINDS; ++k) { fprintf(stderr, " %s %lu/%lu", kinds[k], stats.inputs[k], stats.steps[k]); }
+    const unsigned long *p = stats.whole_phase_steps;
+    const unsigned long *f = stats.whole_fallback_steps;
+    fprintf(stderr, "; whole-shift steps by phase: idle %lu prepare %lu torque %lu inertia %lu lockup %lu locked %lu "
+                    "aborted %lu, by fallback: none %lu finish %lu handback %lu released %lu; shift reports %lu\n",
+            p[0], p[1], p[2], p[3], p[4], p[5], p[6], f[0], f[1], f[2], f[3], stats.reports);
+}
+
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
     verbose = fz_env_flag("WC_FUZZ_VERBOSE");
     make_snapshots();
+    stats.counting = true;
+    (void)atexit(report_stats);
     return 0;
 }
 
@@ -346,10 +372,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     xcp_reset();
     uds_forget();
 
+    const uint32_t steps_before = h.steps;  /* a snapshot's prefix */
     unsigned record = 1u;
     run_records(&h, &r, &record);
     iterate(&h, NULL, true, MAX_RECORDS + 1u, false);  /* empties the ring */
     FZ_CHECK(loop.rx_tail == loop.rx_head, "frames left in the ring after a step");
+    const unsigned kind = uds_running() ? KIND_UDS
+                          : xcp_running() ? KIND_XCP
+                          : (h.whole && (start != 0u)) ? KIND_WHOLE_SNAPSHOT
+                          : h.whole ? KIND_WHOLE_INIT
+                          : h.shift ? KIND_SHIFT : KIND_PLAIN;
+    const unsigned long input_steps = h.steps - steps_before;
+    stats.inputs[kind]++;
+    stats.steps[kind] += input_steps;
+    stats.steps_max = (input_steps > stats.steps_max) ? input_steps : stats.steps_max;
     if (verbose) {
         fprintf(stderr,
                 "fuzz_loop: %zu bytes, clock %d, valid %d, plausible %d: steps %u (control %u, safe %u), frames in %u, "

@@ -16,7 +16,13 @@
 
 #include "wc_fuzz_common.h"
 
-#define MAX_RECORDS 4096u
+/* Records per input. The loop's steps are the fuzzer's cost (a sanitized step with its oracle: 2-4 us), and
+ * libFuzzer mutates up to the longest input it has: the bound is the longest scenario an input needs, a whole
+ * shift from wc_loop_init (660 periods: seeds_loop.py's whole_shift, about 800 records); every timer is a few
+ * hundred steps at most from wc_loop_init or a snapshot (timeouts <= 31 and recovery <= 63 periods, each
+ * phase of the whole shift <= 150 periods from its snapshot, the inertia timeout 270 from the middle one,
+ * UDS_WAIT_STEPS). It was 4096. */
+#define MAX_RECORDS 1024u
 
 typedef struct {
     wc_loop_clock_t clock;
@@ -51,6 +57,20 @@ typedef struct {
 extern wc_loop_t loop;                     /* the loop under test (~1 KiB: static, not on the fuzzer's stack) */
 extern const wc_calibration_t *const cal;  /* table1 */
 extern bool verbose;                       /* WC_FUZZ_VERBOSE */
+
+/* What the fuzzing run executed (printed at exit, scripts/fuzz.sh shows it): inputs and loop steps by kind, the
+ * whole shift's steps by phase and by fallback. Counted from the first input on (not the snapshots' prefixes). */
+enum { KIND_PLAIN, KIND_SHIFT, KIND_WHOLE_INIT, KIND_WHOLE_SNAPSHOT, KIND_XCP, KIND_UDS, KINDS };
+typedef struct {
+    bool counting;
+    unsigned long inputs[KINDS];
+    unsigned long steps[KINDS];
+    unsigned long steps_max;
+    unsigned long whole_phase_steps[7];     /* wc_shift_phase_t: IDLE .. ABORTED */
+    unsigned long whole_fallback_steps[4];  /* WC_SHIFT_FALLBACK_NONE .. RELEASED (the controller's, in Shift mode) */
+    unsigned long reports;                  /* ShiftReports */
+} run_stats_t;
+extern run_stats_t stats;
 
 /* fuzz_loop.c: one wc_loop_iterate and its oracle (then the XCP slave's step); the records of an input; its
  * header (byte 0, the loop configuration, the shift options) into h; a fresh loop (wc_loop_init). */

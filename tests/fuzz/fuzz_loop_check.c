@@ -157,6 +157,11 @@ static void check_whole(harness_t *h, const wc_can_frame_t out[WC_LOOP_TX_FRAMES
         FZ_CHECK(eng.torque_delta_Nm == 0.0f, "TorqueDelta %g with InterventionActive 0", (double)eng.torque_delta_Nm);
     }
 
+    if (stats.counting) {
+        stats.whole_phase_steps[(loop.shift.phase < 7u) ? loop.shift.phase : 6u]++;
+        stats.whole_fallback_steps[h->shift_stepped ? (loop.shift.fallback & 3u) : 0u]++;
+    }
+
     /* alive counters: +1 per step, each frame its own */
     if (h->have_whole_tx) {
         FZ_CHECK(og.alive_counter == (uint8_t)((h->offgoing_alive + 1u) % 16u),

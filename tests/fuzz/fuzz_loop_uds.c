@@ -17,9 +17,9 @@
  *   3  a format byte first (fuzz_loop.c's: bit 7 set, DLC = low nibble, flags = bits 4-6) on the id s & 3
  *      picks: physical, functional, the response id (ours: never a request), or a fuzzed 16-bit id (two
  *      bytes more).
- * The first record's s also configures ISO-TP: frames_per_step 1 + (s & 7); N_Bs and N_Cr 50 steps (an
+ * The first record's s also configures ISO-TP: frames_per_step 1 + (s & 7); N_Bs and N_Cr 10 steps (an
  * input reaches them without being long). The server: 4-byte seed and
- * key (test stand-ins: a counter and an XOR, not a MAC), 3 attempts, a 50-step delay also after init; DIDs
+ * key (test stand-ins: a counter and an XOR, not a MAC), 3 attempts, a 10-step delay also after init; DIDs
  * F190 (17 characters: a segmented answer), FD01 (temperatures), FD02 (learned values; 0x22 without
  * adaptation), FD03 (loop counters); routine 0x0201 the adaptation reset (wc_loop_request_adaptation_reset);
  * ECUReset's hook ends and starts an operation cycle of the fault memory. The fault memory's image is
@@ -56,6 +56,10 @@
 #define UDS_DTCS (UDS_STATUS_TESTS + 1u)           /* and "memory lost" */
 #define UDS_DTC_BASE 0xD0A000u
 #define SECURITY_SEED_SUB 0x01u
+/* N_Bs, N_Cr and the security delay (also after init), in steps of 1 ms: not ISO 15765-2's 1000 ms nor a real
+ * delay, so that an input reaches each timeout with a few records (the loop's steps are the fuzzer's cost; the
+ * timer code is the same for any length). seeds_loop.py UDS_WAIT_STEPS. */
+#define UDS_WAIT_STEPS 10u
 #define SECURITY_KEY_SUB 0x02u
 
 /* The services a request record picks (s & 0x0F); past the end the first data byte is the service id. */
@@ -166,7 +170,7 @@ static void uds_start(uint8_t s)
     *c = (wc_uds_config_t)WC_UDS_CONFIG_DEFAULT;
     c->period_us = (uint32_t)(cal->control_period_s * 1.0e6f + 0.5f);
     c->key_bytes = UDS_KEY_BYTES;
-    c->delay_ms = 50u;  /* 50 steps: an input can wait it out */
+    c->delay_ms = UDS_WAIT_STEPS;  /* an input can wait it out */
     c->dids = dids;
     c->did_count = (uint32_t)(sizeof dids / sizeof dids[0]);
     c->routines = routines;
@@ -183,8 +187,8 @@ static void uds_start(uint8_t s)
     tp.tx_id = UDS_RESPONSE_ID;
     tp.frames_per_step = 1u + (s & 7u);
     tp.period_us = c->period_us;
-    tp.n_bs_ms = 50u;  /* 50 steps, not 1000: an input reaches the timeouts without being long */
-    tp.n_cr_ms = 50u;
+    tp.n_bs_ms = UDS_WAIT_STEPS;  /* not 1000: an input reaches the timeouts without being long */
+    tp.n_cr_ms = UDS_WAIT_STEPS;
     FZ_CHECK(wc_isotp_init(&rig.tp, &tp), "wc_isotp_init refused the harness's configuration");
     uds_on = true;
 }

@@ -1,20 +1,22 @@
 #!/usr/bin/env python3
 """Write the hand-made seed corpora of the libFuzzer harnesses.
 
-    python3 tests/fuzz/make_seeds.py            # rewrites tests/fuzz/corpus/{model,loop,calibration}/
+    python3 tests/fuzz/make_seeds.py            # rewrites tests/fuzz/corpus/{model,loop,calibration,gearbox}/
 
 Standard library only, deterministic (the committed seeds are its output: a
 file in those folders that it no longer makes is removed).
 
 The byte formats are described at the top of each harness (fuzz_model.c,
-fuzz_loop.c, fuzz_calibration.c). The loop's seeds are made in seeds_loop.py
-(its frames follow hil/wetclutch.dbc); the model's and the calibration's here.
+fuzz_loop.c, fuzz_calibration.c, fuzz_gearbox.c). The loop's seeds are made in seeds_loop.py
+(its frames follow hil/wetclutch.dbc), the transmission's in seeds_gearbox.py; the model's and the
+calibration's here.
 """
 import math
 import pathlib
 import struct
 import zlib
 
+from seeds_gearbox import gearbox_seeds
 from seeds_loop import MODE_LOCKED, MODE_OPEN, MODE_TORQUE, loop_seeds
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -177,7 +179,8 @@ def adapt_image_seeds():
 
 def main():
     calibration = {**calibration_seeds(), **adapt_image_seeds()}
-    for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration)):
+    for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration),
+                         ("gearbox", gearbox_seeds())):
         folder = CORPUS / name
         folder.mkdir(parents=True, exist_ok=True)
         for seed, data in sorted(seeds.items()):

@@ -66,14 +66,14 @@ def rec_frame(sel, data, tick=False, kind=1, fault=0, fmt=0x00, other_id=None, e
     return out + data
 
 
-def engagement_profile(periods=80):
-    """(slip rpm, oil, housing, request Nm, mode) per 1 ms period."""
+def engagement_profile(periods=80, open_periods=30):
+    """(slip rpm, oil, housing, request Nm, mode) per 1 ms period: open, a 40-period torque ramp, locked."""
     out = []
     for k in range(periods):
-        if k < 30:
+        if k < open_periods:
             out.append((1500.0, 80.0, 75.0, 0.0, MODE_OPEN))
-        elif k < 70:
-            u = (k - 30) / 40
+        elif k < open_periods + 40:
+            u = (k - open_periods) / 40
             out.append((1500.0 * (1 - u), 80.0, 75.0, 150.0 * u, MODE_TORQUE))
         else:
             out.append((0.0, 80.0, 75.0, 200.0, MODE_LOCKED))
@@ -81,9 +81,11 @@ def engagement_profile(periods=80):
 
 
 def loop_engagement(clock_frame, bench=False):
+    """With bench input three frames a period: 68 periods (open 20), within scripts/fuzz.sh's 2048 bytes."""
     options = (0x01 if clock_frame else 0x00) | (0x02 if bench else 0x00)
     b = bytes([options])
-    for k, (slip, oil, housing, req, mode) in enumerate(engagement_profile()):
+    profile = engagement_profile(68, open_periods=20) if bench else engagement_profile()
+    for k, (slip, oil, housing, req, mode) in enumerate(profile):
         alive = k % 16
         if bench:
             b += rec_frame(SEL_BENCH, bench_frame(800.0 + 5 * k, 120.0, 85.0))
@@ -163,10 +165,11 @@ def rec_xcp(name, *data, aimed=False, tick=False, wait=False):
         bytes(list(data) + [0] * (7 - len(data)))
 
 
-def xcp_session(commands, periods=80):
-    """'make valid' + 'plausible' engagement, one XCP command after each period's frames."""
+def xcp_session(commands):
+    """'make valid' + 'plausible' engagement (torque control from period 5), one XCP command after each
+    period's frames, 10 periods after the last command (the loop's steps are the fuzzer's cost)."""
     b = bytes([0x04 | 0x08])
-    profile = engagement_profile(periods)
+    profile = engagement_profile(len(commands) + 10, open_periods=5)
     for k, (slip, oil, housing, req, mode) in enumerate(profile):
         b += bytes([1 | (SEL_SENSORS << 3), 0x00]) + u16_of(slip, -8000, 8000) + u16_of(oil, -40, 200) + \
             u16_of(housing, -40, 200)
@@ -229,6 +232,7 @@ def xcp_seeds():
 UDS_SIDS = [0x10, 0x11, 0x14, 0x19, 0x22, 0x22, 0x27, 0x27, 0x31, 0x3E, 0x19]
 UDS_DTC_BASE = 0xD0A000     # fuzz_loop_uds.c: DTC i tests VfsCommand status bit i
 STATUS_SAFE_STATE_BIT = 8
+UDS_WAIT_STEPS = 10         # fuzz_loop_uds.c UDS_WAIT_STEPS: N_Bs, N_Cr and the security delay, in steps
 
 
 def rec_uds(kind, s, data, tick=False, fmt=None, other_id=None):
@@ -256,10 +260,12 @@ def uds_raw(*data, functional=False, tick=False):
 FC_CTS = uds_raw(0x30, 0, 0)     # the tester's flow control: ContinueToSend, no further FC, STmin 0
 
 
-def uds_session(records, periods=200):
+def uds_session(records, periods=None):
     """A loop with shift control and adaptation ('make valid' + 'plausible'), the records after each
-    period's frames (one entry per period: bytes, or a tuple of them)."""
+    period's frames (one entry per period: bytes, or a tuple of them); as many periods as records and 5 more
+    (the loop's steps are the fuzzer's cost: no engagement beyond the session)."""
     b = bytes([0x80 | 0x08 | 0x04 | 0x02, 0x00])
+    periods = len(records) + 5 if periods is None else periods
     for k, (slip, oil, housing, req, mode) in enumerate(engagement_profile(periods)):
         b += bytes([1 | (SEL_SENSORS << 3), 0x00]) + u16_of(slip, -8000, 8000) + u16_of(oil, -40, 200) + \
             u16_of(housing, -40, 200)
@@ -283,15 +289,15 @@ def uds_seeds():
         + segmented(0x19, 0x02, 0xFF) + segmented(0x19, 0x0A)
         + segmented(0x19, 0x04, dtc >> 16, (dtc >> 8) & 0xFF, dtc & 0xFF, 0x01)
         + single(0x10, 0x03) + segmented(0x22, 0xFD, 0x02, 0xFD, 0x03)
-        + [b""] * 50                               # the security delay after init (50 steps)
+        + [b""] * UDS_WAIT_STEPS                   # the security delay after init
         + single(0x10, 0x03) + single(0x27, 0x01) + single(0x27, 0x02)  # aimed: the right key
         + single(0x31, 0x01, 0x02, 0x01) + single(0x31, 0x03, 0x02, 0x01) + single(0x14, 0xFF, 0xFF, 0xFF)
         + segmented(0x19, 0x02, 0xFF) + single(0x11, 0x03) + single(0x11, 0x83) + single(0x10, 0x01))
     # a request in a FirstFrame and ConsecutiveFrames: 0x22 with five DIDs (11 bytes); our FC goes out in the
     # step that takes the FF, the answer's FF two steps after the CF
     dids = [0x22, 0xF1, 0x90, 0xFD, 0x01, 0xFD, 0x02, 0xFD, 0x03, 0xFD, 0x04]
-    segmented_request = uds_session([uds_raw(0x10, len(dids), *dids[:6]), uds_raw(0x21, *dids[6:]), b"", FC_CTS],
-                                    periods=60)
+    segmented_request = uds_session([uds_raw(0x10, len(dids), *dids[:6]), uds_raw(0x21, *dids[6:]), b"", FC_CTS]
+                                    + [b""] * 10)
 
     def frame(*records):  # frames that get no answer, or an answer the next step: one period each
         return [r for record in records for r in (record, b"")]
@@ -320,16 +326,15 @@ def uds_seeds():
               rec_uds(3, 2, [0x02, 0x3E, 0x00], fmt=0x88),      # on the response id: not a request
               rec_uds(3, 3, [0x02, 0x3E, 0x00], fmt=0x88, other_id=0x123))  # another id
         + [uds_request(0x22, 0xF1, 0x90), b"", uds_raw(0x31, 0x00, 0x00), b"", uds_raw(0x32, 0x00, 0x00), b""]  # Wait, Overflow
-        + [uds_request(0x22, 0xF1, 0x90)] + [b""] * 55      # no FC: N_Bs (50 steps in the harness) ends it
-        + [uds_raw(0x10, 0x0A, 0x22, 0xF1, 0x90, 0xFD, 0x01)] + [b""] * 55  # no CF: N_Cr (50 steps) ends it
+        + [uds_request(0x22, 0xF1, 0x90)] + [b""] * (UDS_WAIT_STEPS + 2)  # no FC: N_Bs ends it
+        + [uds_raw(0x10, 0x0A, 0x22, 0xF1, 0x90, 0xFD, 0x01)] + [b""] * (UDS_WAIT_STEPS + 2)  # no CF: N_Cr ends it
         + [tuple(uds_raw(0x02, 0x3E, 0x00) for _ in range(20))]  # 20 frames between two steps: the ring (16) overflows
-        + [b""] * 55
+        + [b""] * UDS_WAIT_STEPS
         + frame(uds_request(0x10, 0x03), uds_request(0x27, 0x01), uds_request(0x27, 0x02, 0, 0, 0, 0, first=1),  # 0x35
                 uds_request(0x27, 0x01), uds_request(0x27, 0x02, 0, 0, 0, 0, first=1),
                 uds_request(0x27, 0x01), uds_request(0x27, 0x02, 0, 0, 0, 0, first=1),  # 0x36: the delay
                 uds_request(0x27, 0x01),                          # 0x37
-                uds_request(0x27, 0x02)),                         # no seed: 0x24
-        periods=330)
+                uds_request(0x27, 0x02)))                         # no seed: 0x24
     return {"uds_session": session, "uds_segmented_request": segmented_request, "uds_errors": errors}
 
 
