@@ -142,11 +142,7 @@ static void bench_gearbox_loop(void)
 
 void bench_transmission(void)
 {
-    tx_config.gearbox = &wc_gearbox_8hp;
-    for (uint32_t e = 0u; e < wc_gearbox_8hp.element_count; ++e) { tx_config.element[e] = wc_arm_calibration; }
-    tx_config.shift = &wc_shift_1_2_whole_full;
-    tx_config.holding_margin_factor = 1.2f;
-    tx_config.holding_floor_Nm = 5.0f;
+    wc_test_tx_config(&tx_config, &wc_gearbox_8hp, wc_arm_calibration, &wc_shift_1_2_whole_full);
     bench.transmission = &tx;
     bench.tx_config = &tx_config;
     bench.tx_output = &tx_output;

@@ -342,16 +342,7 @@ static WC_NOINLINE uint32_t encode_whole_shift(wc_loop_t *loop, wc_can_frame_t o
     out[n].dlc = WC_CAN_OFFGOING_VFS_COMMAND_LENGTH;
     out[n].flags = 0u;
     (void)wc_can_encode_offgoing_vfs_command(out[n].data, &command, sizeof out[n].data);
-    const wc_can_engine_torque_request_phys_t engine = {
-        .intervention_active = loop->whole.engine_active ? 1.0f : 0.0f,
-        .torque_delta_Nm = loop->whole.engine_active ? loop->whole.engine_delta_Nm : 0.0f,
-        .alive_counter = loop->tx_alive_engine,
-    };
-    loop->tx_alive_engine = wc_e2e_counter_next(loop->tx_alive_engine);
-    out[n + 1u].id = WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID;
-    out[n + 1u].dlc = WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH;
-    out[n + 1u].flags = 0u;
-    (void)wc_can_encode_engine_torque_request(out[n + 1u].data, &engine, sizeof out[n + 1u].data);
+    wc_loop_engine_frame(loop, loop->whole.engine_active, loop->whole.engine_delta_Nm, &out[n + 1u]);
     return n + WC_LOOP_TX_WHOLE_SHIFT;
 }
 

@@ -119,9 +119,7 @@ static WC_NOINLINE uint32_t encode(wc_loop_t *loop, uint32_t step, wc_can_frame_
         };
         loop->tx_alive_element[e] = wc_e2e_counter_next(loop->tx_alive_element[e]);
         wc_can_frame_t *f = &out[n++];
-        f->id = WC_CAN_ELEMENT_A_VFS_COMMAND_FRAME_ID + e;
-        f->dlc = WC_CAN_ELEMENT_A_VFS_COMMAND_LENGTH;
-        f->flags = 0u;
+        wc_loop_frame_header(f, WC_CAN_ELEMENT_A_VFS_COMMAND_FRAME_ID + e, WC_CAN_ELEMENT_A_VFS_COMMAND_LENGTH);
         if (wc_can_encode_element_a_vfs_command(f->data, &command, sizeof f->data) == WC_CAN_SATURATED) {
             status |= WC_CAN_STATUS_SATURATED;
         }
@@ -138,22 +136,11 @@ static WC_NOINLINE uint32_t encode(wc_loop_t *loop, uint32_t step, wc_can_frame_
         .alive_counter = loop->tx_alive_status,
     };
     loop->tx_alive_status = wc_e2e_counter_next(loop->tx_alive_status);
-    out[n].id = WC_CAN_GEARBOX_STATUS_FRAME_ID;
-    out[n].dlc = WC_CAN_GEARBOX_STATUS_LENGTH;
-    out[n].flags = 0u;
+    wc_loop_frame_header(&out[n], WC_CAN_GEARBOX_STATUS_FRAME_ID, WC_CAN_GEARBOX_STATUS_LENGTH);
     (void)wc_can_encode_gearbox_status(out[n].data, &frame_status, sizeof out[n].data);
     n++;
-    const bool engine = o->engine_active && ((step & STEP_SAFE) == 0u);  /* no engine request in the safe state */
-    const wc_can_engine_torque_request_phys_t request = {
-        .intervention_active = engine ? 1.0f : 0.0f,
-        .torque_delta_Nm = engine ? o->engine_delta_Nm : 0.0f,
-        .alive_counter = loop->tx_alive_engine,
-    };
-    loop->tx_alive_engine = wc_e2e_counter_next(loop->tx_alive_engine);
-    out[n].id = WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID;
-    out[n].dlc = WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH;
-    out[n].flags = 0u;
-    (void)wc_can_encode_engine_torque_request(out[n].data, &request, sizeof out[n].data);
+    /* no engine request in the safe state */
+    wc_loop_engine_frame(loop, o->engine_active && ((step & STEP_SAFE) == 0u), o->engine_delta_Nm, &out[n]);
     return n + 1u;
 }
 

@@ -76,6 +76,29 @@ static inline void wc_loop_input_reset(wc_loop_input_t *in)
     wc_e2e_receiver_init(&in->e2e);
 }
 
+/* An output frame's header: the id, its DBC length, no flags. */
+static inline void wc_loop_frame_header(wc_can_frame_t *f, uint32_t id, uint8_t dlc)
+{
+    f->id = id;
+    f->dlc = dlc;
+    f->flags = 0u;
+}
+
+/* EngineTorqueRequest (DESIGN 14, 15) at *out: the delta when active, else
+ * inactive with 0 N m; its own alive counter. Inline: every period of the
+ * whole shift (a call cost bench/arm's wc_loop_step:whole_shift 9 instructions). */
+static inline void wc_loop_engine_frame(wc_loop_t *loop, bool active, float delta_Nm, wc_can_frame_t *out)
+{
+    const wc_can_engine_torque_request_phys_t engine = {
+        .intervention_active = active ? 1.0f : 0.0f,
+        .torque_delta_Nm = active ? delta_Nm : 0.0f,
+        .alive_counter = loop->tx_alive_engine,
+    };
+    loop->tx_alive_engine = wc_e2e_counter_next(loop->tx_alive_engine);
+    wc_loop_frame_header(out, WC_CAN_ENGINE_TORQUE_REQUEST_FRAME_ID, WC_CAN_ENGINE_TORQUE_REQUEST_LENGTH);
+    (void)wc_can_encode_engine_torque_request(out->data, &engine, sizeof out->data);
+}
+
 /* The transmission (wc_loop_gearbox.c). Its init after wc_loop_init's memset: WC_CAL_NULL when refused. */
 wc_cal_error_t wc_loop_gearbox_init(wc_loop_t *loop, const wc_loop_config_t *config, float theta_start_degC);
 /* One period after the ring was drained (step: the pending status bits): the

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include <wetclutch/wc_transmission.h>
+#include <wetclutch/wetclutch.h>
 #include <wetclutch_can/wc_cal_image.h>
 #include <wetclutch_can/wc_loop.h>
 
@@ -134,13 +135,12 @@ static int step_frames(wc_host_tx_t *h, uint32_t request, uint32_t current_gear,
                        float turbine_torque_Nm, float target_time_s, float turbine_rad_s, float output_rad_s,
                        float oil_degC, float housing_degC, wc_host_tx_step_t *o)
 {
-    static const float rpm_per_rad_s = 30.0f / 3.14159265358979f;
     const wc_can_shift_command_phys_t c = { request ? 1.0f : 0.0f, 0.0f, (float)target_gear,
                                             clamp(turbine_torque_Nm, -1000.0f, 1000.0f),
                                             roundf(clamp(target_time_s * 1e3f, 50.0f, 2000.0f)), (float)current_gear,
                                             h->alive };
-    const wc_can_gearbox_sensors_phys_t s = { oil_degC, clamp(turbine_rad_s * rpm_per_rad_s, -8000.0f, 8000.0f),
-                                              clamp(output_rad_s * rpm_per_rad_s, -8000.0f, 8000.0f),
+    const wc_can_gearbox_sensors_phys_t s = { oil_degC, clamp(turbine_rad_s / WC_RAD_S_PER_RPM, -8000.0f, 8000.0f),
+                                              clamp(output_rad_s / WC_RAD_S_PER_RPM, -8000.0f, 8000.0f),
                                               roundf(housing_degC), h->alive };
     h->alive = wc_e2e_counter_next(h->alive);
     h->in[0] = (wc_can_frame_t){ WC_CAN_SHIFT_COMMAND_FRAME_ID, 8u, 0u, { 0u } };
@@ -178,7 +178,7 @@ static int step_frames(wc_host_tx_t *h, uint32_t request, uint32_t current_gear,
             wc_can_shift_report_phys_t v;
             if (wc_can_decode_shift_report(&v, f.data, f.dlc) > WC_CAN_SATURATED) { return 2; }
             o->ended = 1u;
-            const float report[HOST_REPORT_FIELDS] = { v.inertia_phase_time_ms * 1e-3f, v.slip_rmse_rpm / rpm_per_rad_s,
+            const float report[HOST_REPORT_FIELDS] = { v.inertia_phase_time_ms * 1e-3f, v.slip_rmse_rpm * WC_RAD_S_PER_RPM,
                                                        v.peak_jerk_m_per_s3, v.friction_energy_kJ * 1e3f,
                                                        v.peak_clutch_temp_degC, v.flare, v.tie_up,
                                                        (float)v.abort_reason, NAN /* the fallback: not on the bus */ };

@@ -47,11 +47,7 @@ typedef struct {
 static void rig_init(rig_t *r, uint32_t gear, float turbine_torque_Nm)
 {
     memset(r, 0, sizeof *r);
-    r->tx_config.gearbox = &wc_gearbox_8hp;
-    for (uint32_t e = 0u; e < wc_gearbox_8hp.element_count; ++e) { r->tx_config.element[e] = &wc_table1_calibration; }
-    r->tx_config.shift = &wc_shift_1_2_whole_full;
-    r->tx_config.holding_margin_factor = 1.2f;
-    r->tx_config.holding_floor_Nm = 5.0f;
+    wc_test_tx_config(&r->tx_config, &wc_gearbox_8hp, &wc_table1_calibration, &wc_shift_1_2_whole_full);
     const wc_loop_config_t defaults = WC_LOOP_CONFIG_DEFAULT;
     r->config = defaults;
     r->config.transmission = &r->tx_config;

@@ -38,11 +38,7 @@ typedef struct {
 static void rig_init(rig_t *r, uint32_t gear, float turbine_torque_Nm)
 {
     memset(r, 0, sizeof *r);
-    r->config.gearbox = &wc_gearbox_8hp;
-    for (uint32_t e = 0u; e < wc_gearbox_8hp.element_count; ++e) { r->config.element[e] = &wc_table1_calibration; }
-    r->config.shift = &wc_shift_1_2_whole_full;
-    r->config.holding_margin_factor = 1.2f;
-    r->config.holding_floor_Nm = 5.0f;
+    wc_test_tx_config(&r->config, &wc_gearbox_8hp, &wc_table1_calibration, &wc_shift_1_2_whole_full);
     assert_int_equal(wc_transmission_init(&r->tx, &r->config, gear, OIL_degC), WC_TRANSMISSION_OK);
     r->output_rad_s = OUTPUT_rad_s;
     r->turbine_rad_s = wc_gearbox_8hp.ratio[gear] * OUTPUT_rad_s;

@@ -19,6 +19,19 @@
 
 #include <wetclutch/wc_transmission.h>
 
+/* The tests' and the probe's transmission: every element of the gearbox the
+ * same clutch (element_cal), the shift calibration shift, holding need x 1.2
+ * and at least 5 N m in a gear. */
+static inline void wc_test_tx_config(wc_transmission_config_t *config, const wc_gearbox_t *g,
+                                     const wc_calibration_t *element_cal, const wc_shift_calibration_t *shift)
+{
+    config->gearbox = g;
+    for (uint32_t e = 0u; e < g->element_count; ++e) { config->element[e] = element_cal; }
+    config->shift = shift;
+    config->holding_margin_factor = 1.2f;
+    config->holding_floor_Nm = 5.0f;
+}
+
 /* One period of the plant after the transmission's step (its outputs in out). */
 static inline void wc_test_tx_plant(const wc_gearbox_t *g, const wc_transmission_t *tx,
                                     const wc_transmission_output_t *out, float turbine_torque_Nm, float dt_s,
