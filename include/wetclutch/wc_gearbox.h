@@ -115,8 +115,18 @@ typedef enum {
     WC_SHIFT_TYPE_POWER_OFF_DOWN = 3   /* coast: torque phase, then the on-coming element pulls the turbine up */
 } wc_shift_type_t;
 
+/* A downshift is power-on (a kickdown) only above this turbine torque: its
+ * inertia phase is the engine's torque turning the turbine up (inertia-first,
+ * wc_shift.h), and at less it cannot: 50 N m over the 8HP's 0.98 kg m^2 is
+ * 51 rad/s^2, a 3->2's 98 rad/s in 1.9 s, inside the 3.2 s inertia timeout
+ * (the drive cycle's light-throttle 3->2 at 0-5 N m timed out). Below it the
+ * coast downshift's engine request raises the turbine at any driver torque
+ * (DESIGN 15, beyond the paper). */
+#define WC_GEARBOX_POWER_ON_DOWN_MIN_Nm 50.0f
+
 /* The type of a shift of the table at this turbine torque; a torque of 0
- * counts as power-off (the engine at most drags); NaN: power-on (the type
+ * counts as power-off (the engine at most drags), a downshift's up to
+ * WC_GEARBOX_POWER_ON_DOWN_MIN_Nm; NaN: power-on (the type
  * whose torque phase comes first on an upshift and whose inertia phase is
  * held by the off-going element on a downshift: the element that has the
  * gear keeps it until the torque is known). */

@@ -185,7 +185,9 @@ wc_shift_type_t wc_gearbox_shift_type(const wc_gearbox_t *gearbox, const wc_gear
     WC_ASSERT((gearbox != NULL) && (shift != NULL));
     /* DESIGN 15: an upshift goes to the lower ratio (the check keeps forward ratios decreasing) */
     const bool up = (gearbox == NULL) || (shift == NULL) || (shift->target_gear > shift->source_gear);
-    const bool power_off = turbine_torque_Nm <= 0.0f;  /* false for NaN: power-on */
+    /* false for NaN: power-on; a downshift needs the engine's torque for its inertia phase (wc_gearbox.h) */
+    const float power_on_min_Nm = up ? 0.0f : WC_GEARBOX_POWER_ON_DOWN_MIN_Nm;
+    const bool power_off = turbine_torque_Nm <= power_on_min_Nm;
     if (up) { return power_off ? WC_SHIFT_TYPE_POWER_OFF_UP : WC_SHIFT_TYPE_POWER_ON_UP; }
     return power_off ? WC_SHIFT_TYPE_POWER_OFF_DOWN : WC_SHIFT_TYPE_POWER_ON_DOWN;
 }

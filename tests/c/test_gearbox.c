@@ -112,7 +112,8 @@ static void test_holding_request(void **state)
     assert_float_equal(wc_gearbox_holding_request_Nm(g, 1u, ELEMENT_B, 1e30f, 1.2f, 20.0f), WC_TORQUE_MAX_Nm, 0.0f);
 }
 
-/* DESIGN 15's four types from the direction and the turbine torque's sign. */
+/* DESIGN 15's four types from the direction and the turbine torque (its sign; a downshift's against
+ * WC_GEARBOX_POWER_ON_DOWN_MIN_Nm). */
 static void test_shift_types(void **state)
 {
     (void)state;
@@ -127,6 +128,12 @@ static void test_shift_types(void **state)
     assert_int_equal(wc_gearbox_shift_type(g, down, 300.0f), WC_SHIFT_TYPE_POWER_ON_DOWN);
     assert_int_equal(wc_gearbox_shift_type(g, down, -20.0f), WC_SHIFT_TYPE_POWER_OFF_DOWN);
     assert_int_equal(wc_gearbox_shift_type(g, down, NAN), WC_SHIFT_TYPE_POWER_ON_DOWN);
+    /* a downshift at light throttle is a coast downshift: the kickdown's inertia phase needs the engine's
+     * torque (the drive cycle's 3->2 at 0-5 N m timed out after 3.2 s); an upshift keeps the sign */
+    assert_int_equal(wc_gearbox_shift_type(g, down, 5.0f), WC_SHIFT_TYPE_POWER_OFF_DOWN);
+    assert_int_equal(wc_gearbox_shift_type(g, down, WC_GEARBOX_POWER_ON_DOWN_MIN_Nm), WC_SHIFT_TYPE_POWER_OFF_DOWN);
+    assert_int_equal(wc_gearbox_shift_type(g, down, WC_GEARBOX_POWER_ON_DOWN_MIN_Nm + 1.0f), WC_SHIFT_TYPE_POWER_ON_DOWN);
+    assert_int_equal(wc_gearbox_shift_type(g, up, 5.0f), WC_SHIFT_TYPE_POWER_ON_UP);
     uint32_t per_type[4] = { 0u, 0u, 0u, 0u };
     for (uint32_t i = 0u; i < g->shift_count; ++i) { per_type[wc_gearbox_shift_type(g, &g->shift[i], 100.0f)]++; }
     assert_int_equal(per_type[WC_SHIFT_TYPE_POWER_ON_UP], 18u);    /* the table's 18 upshifts (7 single steps, 11 skips) */

@@ -53,11 +53,11 @@ def tcu() -> Path:
 # (LONGEST_FIRST, as measured on a 2-core machine), so the other worker's work ends with the guest's.
 SLOW_MODULES = {"test_hil_replay", "test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner", "test_xcp_session",
                 "test_uds_session", "test_shift", "test_film_study", "test_identify", "test_replay_inproc", "test_adaptation_study",
-                "test_adaptation_reference", "test_whole_shift"}
+                "test_adaptation_reference", "test_whole_shift", "test_cycle_run"}
 VCAN_MODULES = {"test_vcan_integration", "test_vcan_port_faults", "test_vcan_runner",
                 "test_xcp_session", "test_uds_session"}
 VCAN_TESTS = {"test_vcan_whole_shift_equals_in_process"}
-LONGEST_FIRST = ("vcan", "test_adaptation_study", "test_identify", "test_adaptation_reference", "test_replay_inproc",
+LONGEST_FIRST = ("vcan", "test_cycle_run", "test_adaptation_study", "test_identify", "test_adaptation_reference", "test_replay_inproc",
                  "test_film_study", "test_hil_replay", "test_whole_shift", "test_shift", "test_cli_output_faults",
                  "test_lut", "test_bench", "test_cli_bad_input")
 

@@ -458,6 +458,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --adaptation-study: consecutive shifts per variant (default 16; 200 for the settling"
                         " target, about 2 minutes per variant)")
     q.set_defaults(func=_cmd_shift)
+    q = sub.add_parser("cycle", help="the WLTC class 3b drive cycle (issue 31; DESIGN 16): driver, shift schedule,"
+                       " the firmware's transmission in process at 1 kHz on the 8-speed vehicle plant; the report"
+                       " (GTR 15 speed-trace violations, every shift's quality, the observer against the truth),"
+                       " plots and MDF4; exit 1 when a target is missed")
+    q.add_argument("--vehicle", nargs="+", default=["nominal"], metavar="NAME|PATH",
+                   help="vehicles of tools/plants/8hp (nominal, heavy, light) or 8-speed plant files anywhere"
+                        " (default nominal)")
+    q.add_argument("--phase", choices=("low", "medium", "high", "extra_high", "all"), default="all",
+                   help="the whole cycle (default, 1800 s) or one of its phases (low: 0-589 s)")
+    q.add_argument("--oil", type=float, metavar="DEGC", help="oil temperature (default the vehicle file's)")
+    q.add_argument("--out", default="out/cycle", help="report directory (default out/cycle)")
+    q.set_defaults(func=_cmd_cycle)
     q = sub.add_parser("vehicle-cal", help="write the TCU's driveline model of each vehicle plant"
                        " (tools/plants/vehicles/*.toml -> tools/calibrations/vehicles/*.toml, DESIGN 14)")
     q.add_argument("plants_dir", nargs="?", help="directory of vehicle plant files (default tools/plants/vehicles)")
@@ -529,6 +541,11 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--channel", default="vcan0", help="interface name written in the log (default vcan0)")
     q.set_defaults(func=_cmd_convert)
     return p
+
+
+def _cmd_cycle(args) -> int:
+    from .cycle import report
+    return report.command(args.vehicle, args.phase, args.oil, Path(args.out))
 
 
 def os_error_text(e: OSError) -> str:

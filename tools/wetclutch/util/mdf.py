@@ -1,5 +1,6 @@
 """CAN frames decoded by the DBC (hil/wetclutch.dbc) -> an ASAM MDF 4 file (asammdf): the one MDF writer
-of the package (`wetclutch convert --to mdf4`, the HIL replay report, the shift report).
+of the package (`wetclutch convert --to mdf4`, the HIL replay report, the shift report); and a simulation's
+channels on one time base (``write_channels``: the drive cycle, `wetclutch cycle`).
 
 What the file holds:
   groups    one channel group per CAN frame (message) of the DBC that occurs, in frame-id order; its
@@ -120,6 +121,12 @@ def write(path: Path | str, messages, subject: str, db=None) -> dict:
     """build() written to path atomically (util/atomic: a temporary renamed over path; joins an active
     atomic.Staged block). Returns build()'s summary with "path"."""
     mdf, summary = build(messages, subject, db)
+    summary["path"] = _save(mdf, path)
+    return summary
+
+
+def _save(mdf, path: Path | str) -> str:
+    """mdf saved to path atomically and closed (also when saving fails); the path."""
     try:
         buffer = io.BytesIO()
         mdf.save(buffer, overwrite=True)
@@ -128,8 +135,25 @@ def write(path: Path | str, messages, subject: str, db=None) -> dict:
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     with atomic.open_atomic(path, "wb") as f:
         f.write(buffer.getvalue())
-    summary["path"] = str(path)
-    return summary
+    return str(path)
+
+
+def write_channels(path: Path | str, time_s, channels: dict, subject: str) -> str:
+    """A simulation's channels ({name: (samples, unit)}, each as long as time_s) as one channel group of an
+    MDF 4.10 file, float64 physical values, written atomically as write(). Returns the path."""
+    from asammdf import MDF, Signal
+
+    t = np.asarray(time_s, dtype=float)
+    mdf = MDF(version="4.10")
+    try:
+        _header(mdf, 0.0, subject)
+        mdf.header.description = f"{subject}: simulated channels (wetclutch); time from the cycle's start"
+        mdf.append([Signal(np.asarray(x, dtype=float), t, name=name, unit=unit) for name, (x, unit) in
+                    channels.items()], acq_name=subject, comment=subject)
+    except BaseException:
+        mdf.close()
+        raise
+    return _save(mdf, path)
 
 
 def skipped_text(summary: dict) -> str:

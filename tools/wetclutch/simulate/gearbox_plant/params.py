@@ -15,6 +15,8 @@ A plant file names
                           controller's model (table1); [truth.friction_scale] NAME = { value, unit = "1",
                           source } scales an element's Coulomb friction and static capacity (default 1);
                           aeration_speed: an open element's drag peaks at this slip speed (element);
+                          vfs_time_constant_scale (optional, 0.25..4, default 1): every element's true VFS lag
+                          against its description's (a vehicle whose solenoids the TCU does not know);
   [inertia]               converter_turbine: the converter's turbine wheel (on the gearbox input shaft);
   [engine]                the torque map: speed axis, full-load curve (a fraction of the vehicle's
                           scenario.turbine_torque_full), drag at zero pedal; the idle governor;
@@ -170,7 +172,7 @@ def _truth_calibrations(where: str, doc: dict, gb) -> tuple[dict, dict, str]:
     if not isinstance(truth, dict):
         raise PlantError(f"{where}: 'truth' must be a table")
     for key in truth:
-        if key not in ("calibration", "friction_scale", "aeration_speed"):
+        if key not in ("calibration", "friction_scale", "aeration_speed", "vfs_time_constant_scale"):
             raise PlantError(f"{where}: unknown parameter 'truth.{key}'")
     cal_path = truth.get("calibration")
     if cal_path is None:
@@ -183,15 +185,23 @@ def _truth_calibrations(where: str, doc: dict, gb) -> tuple[dict, dict, str]:
         except CalibrationError as e:
             raise PlantError(f"{where}: parameter 'truth.calibration': {e}") from None
         path = cal_path
+    # the true solenoids' lag against the description's (a vehicle whose VFS differ from those the TCU knows)
+    lag_scale = 1.0
+    if "vfs_time_constant_scale" in truth:
+        lag_scale, _ = _entry(where, doc, "truth", "vfs_time_constant_scale", "1", "pos")
+        if not 0.25 <= lag_scale <= 4.0:
+            raise PlantError(f"{where}: parameter 'truth.vfs_time_constant_scale': {lag_scale!r} must be in [0.25, 4]")
     cals = {}
     for e in gb.elements:
-        if material is None:
+        if material is None and lag_scale == 1.0:
             cals[e.name] = e.calibration
             continue
-        own = {key.split(".", 1)[1] for key in e.overrides}
-        values = {**material.values, **{k: e.calibration.values[k] for k in own}}
-        sources = {**material.sources, **{k: e.calibration.sources[k] for k in own}}
-        cals[e.name] = Calibration(values, sources, f"{path} with element {e.name}'s pack, piston and VFS")
+        base = material or e.calibration
+        own = {key.split(".", 1)[1] for key in e.overrides} if material is not None else set(base.values)
+        values = {**base.values, **{k: e.calibration.values[k] for k in own}}
+        sources = {**base.sources, **{k: e.calibration.sources[k] for k in own}}
+        values["vfs_time_constant"] *= lag_scale
+        cals[e.name] = Calibration(values, sources, f"{path or gb.path} with element {e.name}'s pack, piston and VFS")
     scales = {e.name: 1.0 for e in gb.elements}
     table = truth.get("friction_scale", {})
     if not isinstance(table, dict):

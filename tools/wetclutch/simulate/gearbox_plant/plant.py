@@ -27,7 +27,7 @@ class Plant8:
     """The 8-speed vehicle; see the package docstring. Start it with in_gear(...), then step(...)."""
 
     def __init__(self, params: Plant8Params, *, oil_degC: float | None = None,
-                 friction_scale: dict | None = None, substeps: int = SUBSTEPS):
+                 friction_scale: dict | None = None, substeps: int = SUBSTEPS, record: bool = True):
         p = params
         v = p.vehicle
         self.params = p
@@ -103,21 +103,21 @@ class Plant8:
         self.e_joint = [0.0] * n_j          # friction energy per joint (elements, lock-up, brake), J
         self.ke0 = self.pe0 = 0.0
         self._last = {}
-        self.recorder = Recorder(self)
+        self.recorder = Recorder(self, keep=record)   # a drive cycle keeps its own (1.8 M periods)
 
     # ------------------------------------------------------------------ initialisers
     @classmethod
     def in_gear(cls, params: Plant8Params, gear: str, speed_m_s: float, *, pedal: float = 0.0,
                 currents_mA: dict | None = None, lockup_current_mA: float | None = None,
                 brake_Nm: float = 0.0, oil_degC: float | None = None, theta_degC: dict | float | None = None,
-                friction_scale: dict | None = None, substeps: int = SUBSTEPS) -> "Plant8":
+                friction_scale: dict | None = None, substeps: int = SUBSTEPS, record: bool = True) -> "Plant8":
         """The plant in gear at a vehicle speed (negative in R), in a steady state: the gear's elements at
         currents_mA (default: the gear's elements at their maximum current, the others at 0), the lock-up at
         lockup_current_mA (default: its maximum above the idle speed, 0 below), the engine at the speed where
         its torque at pedal meets the converter's (locked: the turbine's; below the idle speed the idle
         governor's torque), the driveshaft wound to the torque the common acceleration needs, brake_Nm held
         (locked at standstill), the elements' packs at theta_degC (default the oil's)."""
-        plant = cls(params, oil_degC=oil_degC, friction_scale=friction_scale, substeps=substeps)
+        plant = cls(params, oil_degC=oil_degC, friction_scale=friction_scale, substeps=substeps, record=record)
         plant._start(str(gear), float(speed_m_s), float(pedal), currents_mA, lockup_current_mA, float(brake_Nm),
                      theta_degC)
         return plant
@@ -475,5 +475,6 @@ class Plant8:
         return dict(self._state)
 
     def record(self) -> dict:
-        """Every state channel per period, the initial state first: {name: numpy array}."""
+        """Every state channel per period, the initial state first: {name: numpy array} (empty arrays when
+        the plant was made with record=False)."""
         return self.recorder.arrays()

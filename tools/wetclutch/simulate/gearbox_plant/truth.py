@@ -99,10 +99,11 @@ def state_of(plant) -> dict:
 
 
 class Recorder:
-    """Every state channel per period (rows appended by the plant)."""
+    """Every state channel per period (rows appended by the plant); keep=False: the state only, no rows."""
 
-    def __init__(self, plant):
+    def __init__(self, plant, keep: bool = True):
         self.plant = plant
+        self.keep = keep
         self.rows: list = []
         self.names: tuple = ()
 
@@ -110,9 +111,10 @@ class Recorder:
         st = state_of(self.plant)
         if not self.names:
             self.names = tuple(st)
-        self.rows.append(tuple(st[c] for c in self.names))
+        if self.keep:
+            self.rows.append(tuple(st[c] for c in self.names))
         return st
 
     def arrays(self) -> dict:
-        arr = np.array(self.rows, dtype=float)
+        arr = np.array(self.rows, dtype=float).reshape(len(self.rows), len(self.names))
         return {c: arr[:, k].copy() for k, c in enumerate(self.names)}
