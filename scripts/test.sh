@@ -88,6 +88,12 @@ vcan_server_stop() {
   kill "$vcan_pid" 2>/dev/null || true
   wait "$vcan_pid" 2>/dev/null || true
   echo "vcan: one guest ran $(find "$vcan_dir/jobs" -name rc 2>/dev/null | wc -l) vcan commands ($(tail -n 1 "$vcan_dir/log"))"
+  local j cmd  # each command's time in the guest (taken -> rc, the guest's clock): where the vcan stage goes
+  for j in "$vcan_dir"/jobs/*/; do
+    [ -e "$j/taken" ] && [ -e "$j/rc" ] || continue
+    cmd=$(sed -n 's/^declare -a VCAN_CMD=(//p' "$j/env" 2>/dev/null | sed 's/\[[0-9]*\]=//g; s/"//g' | cut -c1-110)
+    printf 'vcan: %6d s  exit %s  %s\n' "$(( $(stat -c %Y "$j/rc") - $(stat -c %Y "$j/taken") ))" "$(cat "$j/rc")" "$cmd"
+  done
   local slowed_ok=0
   if [ "$slow_guest" = 1 ]; then
     echo "vcan: $(cat "$vcan_dir/slow/factor" "$vcan_dir/slow/failed" 2>/dev/null)"

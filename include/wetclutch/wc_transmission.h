@@ -110,6 +110,11 @@ typedef struct {
     bool last_request;
     uint32_t gear_slip_periods;          /* consecutive periods of a gear slip beyond WC_TRANSMISSION_GEAR_SLIP_rad_s */
     bool gear_slipped;                   /* latched until the next shift: the gear held at the maximum current */
+    /* DESIGN 12 per element: each element's learned values; a power-on upshift learns into its on-coming
+     * element's (the running shift's adapt: its values in at the start, out at the end) when the shift
+     * calibration's adaptation is 1. The inertia-first types do not learn yet. */
+    wc_adapt_values_t learned[WC_GEARBOX_ELEMENTS_MAX];
+    wc_adapt_t adapt;
 } wc_transmission_t;
 
 /* In a gear the closed elements are held at the inverse at zero slip; a gear
@@ -126,6 +131,21 @@ typedef struct {
  * refused when requested (WC_GEARBOX_SHIFT_NO_MODEL), not here: the others run. */
 wc_transmission_error_t wc_transmission_init(wc_transmission_t *tx, const wc_transmission_config_t *config,
                                              uint32_t gear, float theta_start_degC);
+
+/* Element e's learned values (DESIGN 12): false for an element the gearbox
+ * does not have. */
+bool wc_transmission_learned(const wc_transmission_t *tx, uint32_t element, wc_adapt_values_t *values);
+
+/* Load element e's learned values (from an adaptation image): refused
+ * (false, nothing changed) during a shift, for an element the gearbox does
+ * not have, or for values outside the shift calibration's bands
+ * (wc_adapt_values_valid). */
+bool wc_transmission_load_learned(wc_transmission_t *tx, const wc_transmission_config_t *config, uint32_t element,
+                                  const wc_adapt_values_t *values);
+
+/* Element e's values back to the calibration's (wc_adapt_reset): refused
+ * during a shift or for an element the gearbox does not have. */
+bool wc_transmission_reset_learned(wc_transmission_t *tx, const wc_transmission_config_t *config, uint32_t element);
 
 /* One control period: the elements' inputs, their steps, the outputs.
  * Returns true when a shift ended this step (*report its quality vector, in

@@ -66,6 +66,26 @@ int wc_host_tx_step(wc_host_tx_t *h, uint32_t request, uint32_t current_gear, ui
                     float turbine_torque_Nm, float target_time_s, float turbine_rad_s, float output_rad_s,
                     float oil_degC, float housing_degC, uint32_t safe, wc_host_tx_step_t *o);
 
+/* Element e's learned values (wc_transmission_learned; direct mode only): 0, or 1 (frames mode, no such
+ * element, NULL). */
+int wc_host_tx_learned(const wc_host_tx_t *h, uint32_t e, wc_adapt_values_t *values);
+int wc_host_tx_learned(const wc_host_tx_t *h, uint32_t e, wc_adapt_values_t *values)
+{
+    if ((h == NULL) || h->frames || (values == NULL) || (e >= HOST_ELEMENTS)) { return 1; }
+    return wc_transmission_learned(&h->tx, e, values) ? 0 : 1;
+}
+
+/* Load element e's learned values (wc_transmission_load_learned: in a gear, within the bands): 0, or 1. */
+int wc_host_tx_load_learned(wc_host_tx_t *h, uint32_t e, const wc_adapt_values_t *values);
+int wc_host_tx_load_learned(wc_host_tx_t *h, uint32_t e, const wc_adapt_values_t *values)
+{
+    if ((h == NULL) || h->frames || (values == NULL)) { return 1; }
+    return wc_transmission_load_learned(&h->tx, &h->config, e, values) ? 0 : 1;
+}
+
+size_t wc_host_tx_learned_size(void);
+size_t wc_host_tx_learned_size(void) { return sizeof(wc_adapt_values_t); }
+
 size_t wc_host_tx_size(void) { return sizeof(wc_host_tx_t); }
 size_t wc_host_tx_step_size(void) { return sizeof(wc_host_tx_step_t); }
 

@@ -31,12 +31,14 @@ static void make_equivalent(const wc_calibration_t *element, float slip_scale, w
     /* DESIGN 15 (matrix8.py): the radii x |a| make R_eff (eq. 3) and with it the torque arm and the static
      * capacity x |a| while the sliding speed R_eff |slip / a| (eq. 4), and so mu_f (eq. 18), the viscous term
      * (eq. 5-8) and eq. 1's power, stay the element's; the squeeze film's Reynolds factor is of degree 4 in
-     * the radii (wc_model.c). Forces, pressures, areas and the heat capacity are the element's. */
+     * the radii (wc_model.c); the open drag's aeration speed is a slip, / |a| in these coordinates (0 stays
+     * off). Forces, pressures, areas, the open clearance and the heat capacity are the element's. */
     const float s = fabsf(slip_scale);
     *out = *element;
     out->outer_radius_m = element->outer_radius_m * s;
     out->inner_radius_m = element->inner_radius_m * s;
     out->film_squeeze_factor = element->film_squeeze_factor / (s * s * s * s);
+    out->open_aeration_speed_rad_s = element->open_aeration_speed_rad_s / s;
 }
 
 wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float slip_scale, wc_calibration_t *out)
@@ -93,6 +95,8 @@ wc_transmission_error_t wc_transmission_init(wc_transmission_t *tx, const wc_tra
         return WC_TRANSMISSION_HOLDING;
     }
     if (!gear_of(g, gear)) { return WC_TRANSMISSION_GEAR; }
+    wc_adapt_reset(&tx->adapt);
+    for (uint32_t e = 0u; e < WC_GEARBOX_ELEMENTS_MAX; ++e) { tx->learned[e] = tx->adapt.values; }
     tx->gear = gear;
     tx->gear_row = row_from(g, gear);
     tx->sign = 1.0f;
@@ -127,6 +131,7 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
     wc_model_set_geometry(&tx->element[row->oncoming].model, &tx->equivalent[0]);
     wc_model_set_geometry(&tx->element[row->offgoing].model, &tx->equivalent[1]);
     wc_shift_init(&tx->shift);
+    tx->adapt.values = tx->learned[row->oncoming];  /* DESIGN 12: the on-coming element's (a power-on upshift's) */
     tx->row = row;
     tx->gear_slip_periods = 0u;  /* a new gear: its slip watched afresh */
     tx->gear_slipped = false;
@@ -215,7 +220,7 @@ static bool shift_step(wc_transmission_t *tx, const wc_transmission_config_t *co
     const uint32_t options = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_UP) ? WC_SHIFT_INERTIA_FIRST_ASSIST
                              : ((tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_DOWN) ? WC_SHIFT_INERTIA_FIRST_ENGINE : 0u);
     const bool ended = torque_first
-        ? wc_shift_step(&tx->shift, &tx->shift_cal, &c, safe, &tx->element[on], NULL, &tx->element_in[on],
+        ? wc_shift_step(&tx->shift, &tx->shift_cal, &c, safe, &tx->element[on], &tx->adapt, &tx->element_in[on],
                         &out->element[on], report, &og)
         : wc_shift_inertia_first_step(&tx->shift, &tx->shift_cal, &c, safe, options, &tx->element[on],
                                       &tx->element_in[on], &out->element[on], report, &og);
@@ -233,7 +238,45 @@ static void end_shift(wc_transmission_t *tx, const wc_transmission_config_t *con
     tx->gear_row = row_from(config->gearbox, tx->gear);
     wc_model_set_geometry(&tx->element[row->oncoming].model, config->element[row->oncoming]);
     wc_model_set_geometry(&tx->element[row->offgoing].model, config->element[row->offgoing]);
+    tx->learned[row->oncoming] = tx->adapt.values;  /* what the shift learned (unchanged where it did not) */
     tx->row = NULL;
+}
+
+bool wc_transmission_learned(const wc_transmission_t *tx, uint32_t element, wc_adapt_values_t *values)
+{
+    WC_ASSERT((tx != NULL) && (values != NULL));
+    if ((tx == NULL) || (values == NULL) || (element >= WC_GEARBOX_ELEMENTS_MAX)) { return false; }
+    *values = tx->learned[element];
+    return true;
+}
+
+/* An element the running configuration has, and no shift running. */
+static bool learned_writable(const wc_transmission_t *tx, const wc_gearbox_t *g, uint32_t element)
+{
+    return (tx->row == NULL) && (g != NULL) && (element < g->element_count);
+}
+
+bool wc_transmission_load_learned(wc_transmission_t *tx, const wc_transmission_config_t *config, uint32_t element,
+                                  const wc_adapt_values_t *values)
+{
+    WC_ASSERT((tx != NULL) && (config != NULL) && (values != NULL));
+    if ((tx == NULL) || (config == NULL) || (values == NULL) || !learned_writable(tx, config->gearbox, element) ||
+        !wc_adapt_values_valid(values, config->shift)) {
+        return false;
+    }
+    tx->learned[element] = *values;
+    return true;
+}
+
+bool wc_transmission_reset_learned(wc_transmission_t *tx, const wc_transmission_config_t *config, uint32_t element)
+{
+    WC_ASSERT((tx != NULL) && (config != NULL));
+    if ((tx == NULL) || (config == NULL) || !learned_writable(tx, config->gearbox, element)) { return false; }
+    wc_adapt_t defaults;
+    (void)memset(&defaults, 0, sizeof defaults);
+    wc_adapt_reset(&defaults);
+    tx->learned[element] = defaults.values;
+    return true;
 }
 
 bool wc_transmission_step(wc_transmission_t *tx, const wc_transmission_config_t *config,

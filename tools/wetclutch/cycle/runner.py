@@ -24,6 +24,7 @@ What is kept (the plant keeps no record: 1.8 M periods would not fit): every 10 
 """
 from __future__ import annotations
 
+import ctypes
 import math
 import time
 from collections import deque
@@ -31,9 +32,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..shift.matrix8 import END_RATIO_TOLERANCE, LOCKUP_MA, RPM, _plant_and_models, plant_path
+from ..shift.matrix8 import CONTROLLER, END_RATIO_TOLERANCE, LOCKUP_MA, RPM, _plant_and_models, plant_path
 from ..shift.quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
-from ..shift.transmission8 import ELEMENTS, LIMITS_JERK, TARGET_S, TYPES, Transmission
+from ..calibration import shift as shift_calibration
+from ..shift.scenarios import SHIFT_TOML, ShiftError
+from ..shift.transmission8 import ELEMENTS, LIMITS_JERK, TARGET_S, TYPES, AdaptValues, Transmission
 from ..simulate.gearbox_plant import Plant8
 from .driver import Driver, DriverParams
 from .schedule import DEFAULT_SCHEDULE, load_schedule
@@ -64,6 +67,8 @@ class CycleResult:
     dropped: list                   # requests the TCU never engaged
     cpu_s: float
     periods: int
+    adaptation: bool = False
+    learned: dict = field(default_factory=dict)      # element -> its learned values at the end (AdaptValues.as_dict)
     notes: list = field(default_factory=list)
 
 
@@ -199,10 +204,27 @@ CHANNELS = ("t_s", "target_kmh", "speed_kmh", "pedal", "brake_Nm", "gear", "phas
                                                        for c in ("theta_degC", "theta_est_degC", "current_mA"))
 
 
+def _transmission(gearbox_path, oil_degC: float, lib, adaptation: bool, learned: dict | None) -> Transmission:
+    """The firmware's transmission on the controller's shift calibration, with its adaptation (DESIGN 12) on or
+    off, each element's learned values loaded from ``learned`` (element -> AdaptValues.as_dict)."""
+    base = shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
+    shift = shift_calibration.ShiftCalibration(f"{base.name}+adaptation", {**base.values, "adaptation": 1},
+                                               base.sources) if adaptation else base
+    tx = Transmission(gearbox_path, 1, oil_degC, lib, shift=shift)
+    for name, v in (learned or {}).items():
+        values = AdaptValues((ctypes.c_float * 5)(*v["friction_scale"]), (ctypes.c_float * 5)(*v["confidence"]),
+                             v["film_factor"], v["kiss_offset_Pa"], int(v["shifts_learned"]))
+        if name not in ELEMENTS or not tx.load_learned(ELEMENTS.index(name), values):
+            raise ShiftError(f"learned values of element {name!r} refused (not an element, or outside the bands)")
+    return tx
+
+
 def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: float | None = None,
-              schedule_path=DEFAULT_SCHEDULE, seed: int = 1, lib=None, progress=None) -> CycleResult:
+              schedule_path=DEFAULT_SCHEDULE, seed: int = 1, lib=None, progress=None, adaptation: bool = False,
+              learned: dict | None = None) -> CycleResult:
     """Drive ``trace`` (default: the WLTC class 3b from wltp) on the vehicle (a name of tools/plants/8hp or an
-    8-speed plant file anywhere); progress(t_s) is called every simulated second."""
+    8-speed plant file anywhere); progress(t_s) is called every simulated second. adaptation: the TCU learns
+    (a power-on upshift into its on-coming element), starting from ``learned`` (a previous result's)."""
     from .trace import load_wltc_class3b
     trace = trace if trace is not None else load_wltc_class3b()
     params, _models = _plant_and_models(str(plant_path(vehicle)))
@@ -215,7 +237,7 @@ def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: f
     standing = trace.speed_kmh_at(t0) <= 0.0
     plant = Plant8.in_gear(params, "1", trace.speed_mps_at(t0), lockup_current_mA=0.0, oil_degC=oil,
                            brake_Nm=1500.0 if standing else 0.0, record=False)
-    tx = Transmission(gb.path, 1, oil, lib)
+    tx = _transmission(gb.path, oil, lib, adaptation, learned)
     driver = Driver(trace, _driver_params(params), dt_s=DT_S * DRIVER_PERIOD)
     scheduler = Scheduler(schedule, 1)
     rng = np.random.default_rng(seed)
@@ -255,9 +277,11 @@ def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: f
                 kind = _kind(direction, torque_est)
                 window = _ShiftWindow(new, kind, torque_est, pre, locked)
             # the lock-up (the integrator's side): closed from the schedule's gear and speed and kept closed
-            # through the shifts (the TCU's reduced model of a shift has the engine's inertia turning with the
-            # turbine: matrix8); it starts closing only between shifts, LOCKUP_DELAY_S after the last one ended
-            wanted = gear_reported >= schedule.lockup_min_gear and st["output_speed_rpm"] >= schedule.lockup_min_output_rpm
+            # through a shift that started with it closed, also below the speed (the TCU's reduced model of a
+            # shift has the engine's inertia turning with the turbine: matrix8); it starts closing only between
+            # shifts, LOCKUP_DELAY_S after the last one ended
+            wanted = (gear_reported >= schedule.lockup_min_gear and st["output_speed_rpm"] >= schedule.lockup_min_output_rpm) \
+                or (window is not None and window.lockup_locked)
             if not wanted:
                 lockup_mA = 0.0
             elif lockup_mA > 0.0 or (request is None and window is None and t - t_shift_end >= LOCKUP_DELAY_S):
@@ -311,4 +335,5 @@ def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: f
         shifts.append(shift_quality(window, gb, ratios))
     channels = {c: np.asarray(x, dtype=float) for c, x in keep.items()}
     return CycleResult(str(vehicle), trace, channels, shifts, list(scheduler.requests), list(scheduler.dropped),
-                       time.process_time() - cpu0, n)
+                       time.process_time() - cpu0, n, adaptation,
+                       {e: tx.learned(i).as_dict() for i, e in enumerate(ELEMENTS)})

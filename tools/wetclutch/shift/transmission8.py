@@ -29,6 +29,9 @@ the time from the request to the turbine at the new gear's speed (within END_RAT
 kickdown's at full load within KICKDOWN_NEW_SPEED_S);
 per element its friction energy; the on-coming element's peak temperature, estimate and truth. Tie-up is not
 measured here yet.
+
+trace_shift: the same run with its per-period traces (ShiftTrace: the plant's truth, the TCU's outputs); --plots
+(on with --matrix): one Fig. 4-style figure per shift type from them (transmission8_plots, PLOT_CASES).
 """
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ import ctypes
 import json
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -72,6 +76,17 @@ class _Step(ctypes.Structure):
                 ("report", ctypes.c_float * 9)]
 
 
+class AdaptValues(ctypes.Structure):
+    """wc_adapt_values_t (include/wetclutch/wc_adapt.h): an element's learned values (DESIGN 12)."""
+    _fields_ = [("friction_scale", ctypes.c_float * 5), ("confidence", ctypes.c_float * 5),
+                ("film_factor", ctypes.c_float), ("kiss_offset_Pa", ctypes.c_float), ("shifts_learned", ctypes.c_uint32)]
+
+    def as_dict(self) -> dict:
+        return {"friction_scale": list(self.friction_scale), "confidence": list(self.confidence),
+                "film_factor": self.film_factor, "kiss_offset_Pa": self.kiss_offset_Pa,
+                "shifts_learned": self.shifts_learned}
+
+
 def _library(path: Path = LIBRARY):
     if not Path(path).is_file():
         raise ShiftError(f"{path} not built (cmake --preset host-release && cmake --build --preset host-release)")
@@ -83,15 +98,21 @@ def _library(path: Path = LIBRARY):
     f, u = ctypes.c_float, ctypes.c_uint32
     lib.wc_host_tx_init.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
     lib.wc_host_tx_step.argtypes = [ctypes.c_void_p, u, u, u, f, f, f, f, f, f, u, ctypes.POINTER(_Step)]
+    lib.wc_host_tx_learned_size.restype = ctypes.c_size_t
+    if lib.wc_host_tx_learned_size() != ctypes.sizeof(AdaptValues):
+        raise ShiftError("libwc_transmission_host's learned values differ from transmission8.AdaptValues")
+    lib.wc_host_tx_learned.argtypes = [ctypes.c_void_p, u, ctypes.POINTER(AdaptValues)]
+    lib.wc_host_tx_load_learned.argtypes = [ctypes.c_void_p, u, ctypes.POINTER(AdaptValues)]
     return lib
 
 
 class Transmission:
     """wc_transmission_step in process on the gearbox's element calibrations and the shift calibration."""
 
-    def __init__(self, gearbox_path, gear: int, theta_start_degC: float, lib=None):
+    def __init__(self, gearbox_path, gear: int, theta_start_degC: float, lib=None, shift=None):
+        """shift: a ShiftCalibration (default the controller's, CONTROLLER of tools/calibrations/shift_1_2.toml)."""
         self.lib = lib or _library()
-        base = shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
+        base = shift or shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
         images = [cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), e),
                                                **cal_image._shift_values(None),          # noqa: SLF001
                                                **cal_image.loop_values(None, False)}) for e in ELEMENTS]
@@ -105,6 +126,16 @@ class Transmission:
         if rc != 0:
             raise ShiftError(f"wc_host_tx_init refused the configuration (code {rc})")
         self.out = _Step()
+
+    def learned(self, element: int) -> AdaptValues:
+        v = AdaptValues()
+        if self.lib.wc_host_tx_learned(self.state, element, ctypes.byref(v)) != 0:
+            raise ShiftError(f"no learned values for element {element}")
+        return v
+
+    def load_learned(self, element: int, values: AdaptValues) -> bool:
+        """False: refused (in a shift, or outside the shift calibration's bands)."""
+        return self.lib.wc_host_tx_load_learned(self.state, element, ctypes.byref(values)) == 0
 
     def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> _Step:
         self.lib.wc_host_tx_step(self.state, int(request), current, target, torque_Nm, target_s, w_t, w_o, oil,
@@ -121,9 +152,62 @@ def _end_gear(plant, st) -> str | None:
     return None
 
 
+# wc_shift_phase_t (include/wetclutch/wc_shift.h; GearboxStatus.ShiftPhase), by value
+PHASES = ("idle", "prepare", "torque", "inertia", "lock-up", "locked", "aborted")
+# A ShiftTrace's TCU channels: what wc_transmission_step put out per period (_Step): per element its current, its
+# observer's temperature and its model's torque (during the shift the on-coming and off-going elements' are their
+# equivalent clutches' in the controller's frame, wc_transmission.h), the engine intervention and whether it is
+# active, the shift phase (PHASES) and the gear
+TCU_CHANNELS = (*(f"{e}_current_mA" for e in ELEMENTS), *(f"{e}_theta_degC" for e in ELEMENTS),
+                *(f"{e}_model_torque_Nm" for e in ELEMENTS), "engine_delta_Nm", "engine_active", "phase", "gear")
+
+
+def _tcu_row(o: _Step) -> tuple:
+    return (*o.current_mA, *o.theta_degC, *o.model_torque_Nm, o.engine_delta_Nm, o.engine_active, o.phase, o.gear)
+
+
+@dataclass(frozen=True)
+class ShiftTrace:
+    """One shift's run (trace_shift): its quality dict and its per-period traces. truth: the plant's record
+    (Plant8.record(), gearbox_plant.truth.STATE_DOC), row k the state at the start of period k, rows 0 .. n; tcu
+    (TCU_CHANNELS; empty from run_shift): what the TCU put out in period k = 0 .. n - 1, computed from the
+    measurement of truth row k and applied over period k (the plant records that period's currents in row k + 1);
+    request_index the period of the request's edge, end_index the one the shift ended in (None: it did not);
+    ratios the source and the target gear's (their synchronous turbine speeds: ratio x the output speed)."""
+    quality: dict
+    truth: dict
+    tcu: dict
+    request_index: int
+    end_index: int | None
+    ratios: tuple[float, float]
+    oncoming: str
+    offgoing: str
+
+    def time_s(self) -> np.ndarray:
+        """The truth rows' times from the request (the TCU's row k is at row k's)."""
+        return self.truth["t_s"] - self.truth["t_s"][self.request_index]
+
+    def phase_changes(self) -> list[tuple[int, str]]:
+        """(period, the new phase's name) wherever the TCU's shift phase changes from the request on."""
+        phase = self.tcu["phase"].astype(int)
+        k0 = self.request_index
+        return [(k, PHASES[phase[k]]) for k in range(k0, phase.size) if k == k0 or phase[k] != phase[k - 1]]
+
+
 def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, oil_degC: float = OIL_DEGC,
               seed: int = 1, lib=None) -> dict:
     """One shift source -> target of the kind's scenario in closed loop: its quality dict (module docstring)."""
+    return _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu=False).quality
+
+
+def trace_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, oil_degC: float = OIL_DEGC,
+                seed: int = 1, lib=None) -> ShiftTrace:
+    """run_shift's run with its per-period traces (ShiftTrace: its .quality is run_shift's dict)."""
+    return _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu=True)
+
+
+def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu: bool) -> ShiftTrace:
+    """The closed loop of run_shift; keep_tcu: the TCU's outputs kept per period (else ShiftTrace.tcu is empty)."""
     params, _models = _plant_and_models(str(plant_path(vehicle)))
     direction, pedal, rpm = SCENARIOS[kind]
     if target - source != direction * abs(target - source):
@@ -141,6 +225,7 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
     n_max = n_pre + int(round((v.shift_duration + 2.0) / dt))
     st, engine_delta, end_k, report, kind_seen = plant.state, 0.0, None, None, None
     theta_estimate = []          # the on-coming element's observer per period
+    tcu_rows = []                # keep_tcu: the TCU's outputs per period (_tcu_row)
     on_index = _oncoming_index(params, src, tgt)
     for k in range(n_max):
         z = rng.standard_normal(4)
@@ -156,6 +241,8 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
         currents = {e: float(o.current_mA[i]) for i, e in enumerate(ELEMENTS)}
         engine_delta = float(o.engine_delta_Nm) if o.engine_active else 0.0
         theta_estimate.append(float(o.theta_degC[on_index]))
+        if keep_tcu:
+            tcu_rows.append(_tcu_row(o))
         if o.ended and end_k is None:
             end_k, report = k, list(o.report)
         st = plant.step(currents, LOCKUP_MA, pedal, engine_delta)
@@ -163,8 +250,12 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
             break
     truth = plant.record()
     on = ELEMENTS[on_index]
-    return _quality(plant, truth, theta_estimate, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt), kind_seen,
-                    {"vehicle": str(vehicle), "kind": kind, "load": load, "oil_degC": oil_degC, "pedal": pedal})
+    quality = _quality(plant, truth, theta_estimate, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt),
+                       kind_seen, {"vehicle": str(vehicle), "kind": kind, "load": load, "oil_degC": oil_degC,
+                                   "pedal": pedal})
+    tcu = dict(zip(TCU_CHANNELS, np.array(tcu_rows, dtype=float).T)) if tcu_rows else {}
+    off = next(iter(set(params.gearbox.gears[src]) - set(params.gearbox.gears[tgt])))
+    return ShiftTrace(quality, truth, tcu, n_pre, end_k, (ratio_src, ratio_tgt), on, off)
 
 
 def _oncoming_index(params, src: str, tgt: str) -> int:
@@ -213,6 +304,8 @@ LIMITS_JERK = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on dow
 EXCURSION_RPM, THETA_K, INERTIA_TOLERANCE = 30.0, 5.0, 0.10
 KICKDOWN_NEW_SPEED_S = 0.6       # issue 29: a kickdown's turbine at the new gear's speed within 0.6 s at full load
 SKIP_DOWNS = ((8, 6), (7, 5), (6, 4), (5, 3), (4, 2), (3, 1))   # DESIGN 15's single-element skips
+# the plots per type (transmission8_plots): the first case of each type in CASES (2->3 up, 3->2 down)
+PLOT_CASES = tuple(next(c for c in CASES if c[2] == kind) for kind in TYPES.values())
 
 
 def matrix_cases(loads=(1.0, 0.25)) -> list[tuple]:
@@ -304,6 +397,26 @@ def run_matrix(out: Path, vehicles, oils, loads, processes: int = 2) -> int:
     return 1 if bad else 0
 
 
+def run_plots(out: Path, vehicle: str = "nominal", oil_degC: float = OIL_DEGC, lib=None) -> list[Path]:
+    """One Fig. 4-style PNG per shift type (transmission8_plots) of PLOT_CASES at full load on the vehicle:
+    OUT/<type>.png, all four or none. Returns the paths."""
+    from . import transmission8_plots
+    lib = lib or _library()
+    traces = [trace_shift(vehicle, s, t, k, oil_degC=oil_degC, lib=lib) for s, t, k in PLOT_CASES]
+    return transmission8_plots.write_plots(out, traces)
+
+
+def _plots(out: Path, vehicle: str) -> int:
+    """run_plots for the command line: 0, or 2 when a shift could not run (as a single run's)."""
+    try:
+        paths = run_plots(out, vehicle)
+    except ShiftError as e:
+        print(f"transmission8: plots not written: {e}", file=sys.stderr)
+        return 2
+    print(f"transmission8: {len(paths)} plots (one per shift type) in {out}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m wetclutch.shift.transmission8", description=__doc__.split("\n")[0])
     ap.add_argument("--vehicle", default="nominal", help="a vehicle of tools/plants/8hp or an 8-speed plant file")
@@ -313,9 +426,16 @@ def main(argv=None) -> int:
     ap.add_argument("--vehicles", nargs="+", default=["nominal", "heavy", "light"], help="with --matrix")
     ap.add_argument("--oil", nargs="+", type=float, default=[OIL_DEGC], help="with --matrix: oil temperatures, degC")
     ap.add_argument("--loads", nargs="+", type=float, default=[1.0, 0.25], help="with --matrix: power-on loads")
+    ap.add_argument("--plots", action=argparse.BooleanOptionalAction, default=None,
+                    help="one Fig. 4-style PNG per shift type (PLOT_CASES on --vehicle at 80 degC) in OUT/plots, OUT"
+                    " the matrix's folder (else out/transmission8); on with --matrix unless --no-plots; exit 2 when"
+                    " one of those shifts cannot run")
     args = ap.parse_args(argv)
+    plots = args.matrix if args.plots is None else args.plots
     if args.matrix:
-        return run_matrix(args.out or Path("out/transmission8"), args.vehicles, args.oil, args.loads)
+        out = args.out or Path("out/transmission8")
+        rc = run_matrix(out, args.vehicles, args.oil, args.loads)
+        return max(rc, _plots(out / "plots", args.vehicle)) if plots else rc
     results = []
     for source, target, kind in CASES:
         try:
@@ -332,7 +452,7 @@ def main(argv=None) -> int:
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.write_text(json.dumps(results, indent=1))
-    return 0
+    return _plots(Path("out/transmission8/plots"), args.vehicle) if plots else 0
 
 
 if __name__ == "__main__":
