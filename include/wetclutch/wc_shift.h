@@ -366,45 +366,63 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
                    wc_shift_report_t *report, wc_shift_offgoing_t *offgoing);
 
 /* The inertia-phase-first shift (DESIGN 15: the power-on downshift, the
- * kickdown; mirrored by wc_transmission, the power-off upshift): the
- * off-going clutch (offgoing, required) lets the turbine run to the target
- * gear's speed on the reference slip while the on-coming clutch (clutch)
- * waits filled at its kiss point; at synchronism the torque phase hands the
- * torque over. In the controller's frame the turbine torque is >= 0 (with
+ * kickdown; mirrored by wc_transmission, the power-off upshift, the tip-out;
+ * with WC_SHIFT_INERTIA_FIRST_ENGINE, not mirrored, the power-off downshift,
+ * the coast): the off-going clutch (offgoing, required) lets the turbine run
+ * to the target gear's speed on the reference slip (the coast: the engine
+ * moves it, below) while the on-coming clutch (clutch) waits, open or at its
+ * kiss point; at synchronism the torque phase hands the torque over. In the
+ * controller's frame the turbine torque is >= 0 (with
  * WC_SHIFT_INERTIA_FIRST_ENGINE <= 0), the on-coming slip starts negative (the
  * turbine below the target gear's speed) and the off-going slip turns
- * positive. Phases:
- *   PREPARE   prepare_time_s: with the assist the on-coming clutch filled (the
- *             fill pulse, then the kiss point); without it the fill is timed
- *             to arrive at synchronism: open until the reference leaves
- *             prepare_time_s, then the fill pulse and the kiss point (filled
- *             early it drags across the whole slip: a tie-up). The
- *             off-going request ramps from
- *             offgoing_holding_factor x T_t to (1 + offgoing_margin_factor) x T_t,
- *             just above what it carries.
+ * positive. k_1 = 1 / I_t + b b1 / I_out, k_c = 1 / I_t + b^2 / I_out.
+ * Phases:
+ *   PREPARE   prepare_time_s: the off-going request ramps from
+ *             offgoing_holding_factor x |T_t| to (1 + offgoing_margin_factor)
+ *             x what it carries, |T_t| / (I_t k_1) (less than T_t by the
+ *             turbine's share of the vehicle's acceleration): just above it.
+ *             With WC_SHIFT_INERTIA_FIRST_ASSIST (the tip-out) the on-coming
+ *             clutch waits at its kiss point from the start, without the fill
+ *             pulse (its overshoot at the whole slip pushed the turbine
+ *             down); without it (the kickdown, the coast) it stays open.
  *   INERTIA   the reference slip from the on-coming slip at the phase start
- *             (below -min_start_slip_rad_s, else AbortReason 6) to 0 as in
- *             the torque-first shift; the hold-back = feed-forward
- *             (T_t / I_t - dref/dt) / (1 / I_t + b b1 / I_out) + PI(slip -
- *             reference) is the off-going request. Without WC_SHIFT_INERTIA_FIRST_ASSIST
- *             (the kickdown: the engine sets the pace) the on-coming clutch
- *             waits at its kiss point and a target faster than T_t can move
- *             the turbine is stretched to the time it can (1.25 x 1.5
- *             |slip_0| I_t / T_t, at most inertia_time_max_s); with it (the
- *             tip-out: a small drag would take seconds) a negative hold-back
- *             is the on-coming clutch's push, x (1 / I_t + b b1 / I_out) /
- *             (1 / I_t + b^2 / I_out), in the commanded time. Ends as
+ *             (below -min_start_slip_rad_s, else AbortReason 6) to 0: for the
+ *             kickdown and the tip-out its rate a trapezoid (ramps no steeper
+ *             than the slip jerk that gives the vehicle a design jerk through
+ *             jerk_per_torque_rate, 12 m/s^3 for the kickdown, 3 for the
+ *             tip-out; at least 0.4 T for the kickdown where the flat rate
+ *             stays within what T_t can do, else down to T / 3, and T / 3 for
+ *             the tip-out; a zero slope at synchronism), for the coast DESIGN
+ *             10's smoothstep. The hold-back = feed-forward (T_t / I_t -
+ *             dref/dt) / k_1 + PI(slip - reference) is the off-going request.
+ *             Without the assist (the kickdown, the coast: the engine sets the
+ *             pace) the on-coming clutch's fill is timed to arrive at
+ *             synchronism: open until the reference leaves prepare_time_s to
+ *             its end, then the fill pulse and the kiss point (filled early it
+ *             drags across the whole slip: a tie-up); and a target faster than
+ *             the turbine can be moved (by T_t; the coast: T_t0 +
+ *             engine_increase_max_Nm) is stretched to the shortest reference
+ *             it can follow (the flat rate within that torque / (1.15 I_t),
+ *             the kickdown's ramps within its jerk; at most
+ *             inertia_time_max_s). With it (the tip-out: a small
+ *             drag would take seconds) a negative hold-back is the on-coming
+ *             clutch's push, x k_1 / k_c, in the commanded time; once the
+ *             hold-back is spent the off-going clutch opens for good. Ends as
  *             the torque-first inertia phase (the lock band's dwell, or the
- *             reference ended within min_start_slip_rad_s); flare: the slip
+ *             reference ended within min_start_slip_rad_s) or, where the
+ *             off-going clutch no longer drives the slip (the tip-out's push,
+ *             the coast's engine), when the slip reaches 0; flare: the slip
  *             above +flare_slip_rad_s (past synchronism).
  *   TORQUE    torque_phase_time_s at synchronism: the on-coming request
  *             rises on a smoothstep to holding_torque_factor x its carried
  *             torque (+ flare_kp x the slip past synchronism + flare_ki x its
- *             integral: the turbine running past is taken in closed loop)
- *             while the off-going request falls from its last value to
- *             0 on the same smoothstep; LOCKED once the on-coming clutch is
- *             locked and the ramp done; not locked after WC_SHIFT_LOCKUP_WAIT
- *             ramp times: AbortReason 2.
+ *             integral: the turbine running past is taken in closed loop;
+ *             after a coast, below it: T_t < 0 drags the turbine back) while
+ *             the off-going request falls from its last value to 0 on the
+ *             same smoothstep (open at once when it held nothing or had
+ *             opened for good); LOCKED once the on-coming clutch is locked
+ *             and the ramp done; not locked after WC_SHIFT_LOCKUP_WAIT ramp
+ *             times: AbortReason 2.
  *   LOCKED / ABORTED as the torque-first shift. A lost input (safe): before
  *             the torque phase handed back (the off-going clutch at its
  *             maximum current, AbortReason 3, fallback HANDBACK); from the
@@ -414,17 +432,20 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  * With WC_SHIFT_INERTIA_FIRST_ENGINE (the coast downshift, not mirrored: T_t
  * <= 0, the engine drags and cannot raise the turbine) the engine does the
  * inertia phase (DESIGN 15: "engine torque increase requested"): the request
- * I_t dref/dt - T_t0 at the reference engine_lead_time_s ahead, plus what the
- * PI asks beyond the hold-back's feed-forward when the turbine lags (x k_1
- * I_t), at most engine_increase_max_Nm, ramped out over the torque phase; the
- * off-going clutch only holds back (>= 0) when the turbine runs ahead, and
- * the target is stretched to what T_t0 + engine_increase_max_Nm can do.
- * The on-coming clutch then never drags the vehicle into the turbine's
- * acceleration. Without it no engine request (engine_active false). No
- * adaptation in this type yet; the report's friction energy is both
- * clutches' (the off-going one does the inertia phase's work), its jerk that
- * of the output torque T_c + (b1 / b) T_1, tie_up never set (the plant
- * measures it). */
+ * I_t dref/dt - T_t0 at the reference engine_lead_time_s ahead, corrected by
+ * the PI both ways (-PI k_1 I_t: more when the turbine lags, less when it
+ * runs ahead) with its gains scaled to the engine's lag (kp to a crossover at
+ * 1 / (2 engine_lead_time_s), ki by the square of that factor), within 0 ..
+ * engine_increase_max_Nm; at synchronism cut to what cancels the drag and
+ * ramped out over the torque phase. The off-going clutch carries what is left
+ * of the drag (with the margin) while the engine's torque rises through 0,
+ * at the latest for engine_lead_time_s, then opens for good; the target is
+ * stretched to what T_t0 + engine_increase_max_Nm can do. The on-coming
+ * clutch then never drags the vehicle into the turbine's acceleration.
+ * Without it no engine request (engine_active false). No adaptation in this
+ * type yet; the report's friction energy is both clutches' (the off-going one
+ * does the inertia phase's work), its jerk that of the output torque T_c +
+ * (b1 / b) T_1, tie_up never set (the plant measures it). */
 #define WC_SHIFT_INERTIA_FIRST_ASSIST 1u  /* the tip-out: a negative hold-back is the on-coming clutch's push */
 #define WC_SHIFT_INERTIA_FIRST_ENGINE 2u  /* the coast downshift: the engine request moves the turbine */
 bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t *cal,

@@ -6,16 +6,18 @@
  * wc_shift.h on the shift's reduced model (the paper's §2 reduction,
  * wc_gearbox.h):
  *
- *   type (wc_gearbox_shift_type)  controller          frame
- *   power-on upshift              wc_shift_step       as is (today's 1->2 controller)
- *   power-off downshift (coast)   wc_shift_step       mirrored
- *   power-on downshift (kickdown) inertia-first       as is
- *   power-off upshift (tip-out)   inertia-first       mirrored, the on-coming assist on
+ *   type (wc_gearbox_shift_type)  controller      frame     options (wc_shift.h)
+ *   power-on upshift              wc_shift_step   as is     (today's 1->2 controller)
+ *   power-off downshift (coast)   inertia-first   as is     WC_SHIFT_INERTIA_FIRST_ENGINE: the engine
+ *                                                           request moves the turbine
+ *   power-on downshift (kickdown) inertia-first   as is     none: T_t moves the turbine
+ *   power-off upshift (tip-out)   inertia-first   mirrored  WC_SHIFT_INERTIA_FIRST_ASSIST: the on-coming
+ *                                                           element's push
  *
  * Mirrored: the controller sees every speed, slip and torque negated (the
- * driveline's equations are odd in them, so a coast downshift is a power-on
- * upshift's dynamics with the turbine torque -T_t >= 0, DESIGN 15); the
- * engine request it returns is negated back. The controller's clutches are
+ * driveline's equations are odd in them, so a tip-out is a kickdown's
+ * dynamics with the turbine torque -T_t >= 0, DESIGN 15); the engine request
+ * it returns is negated back. The controller's clutches are
  * the on-coming and off-going elements as equivalent clutches in the
  * controller's coordinates (slip / a): radii x |a| and the squeeze-film
  * factor / a^4, so that the model's torque is |a| x the element's and its

@@ -3,10 +3,16 @@
 nominal vehicle. Asserted: the type the firmware picks, completion (AbortReason 0) in the target gear by the
 plant's truth, the inertia phase within its target, the on-coming element's observer within 5 K of its true
 temperature, issue 29's comfort targets (peak jerk by type, flare and sag) and the kickdown's new gear's speed
-within 0.6 s; a target missed is a strict xfail with its figures."""
+within 0.6 s; a target missed is a strict xfail with its figures. The plots per type (transmission8_plots): one
+PNG per type, drawn from traces that are the run's (the quality recomputed from them); the command line's --plots."""
+import json
+
+import numpy as np
 import pytest
 
 from wetclutch.shift import transmission8 as t8
+from wetclutch.shift import transmission8_plots as t8_plots
+from wetclutch.shift.quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
 
 pytestmark = pytest.mark.slow   # needs the host-release build (libwc_transmission_host.so)
 
@@ -127,3 +133,60 @@ def test_matrix_names_every_missed_target():
         m = t8.missed({**kick, "new_speed_s": late})
         assert len(m) == 1 and "new gear's speed" in m[0], (late, m)
     assert t8.missed({**kick, "new_speed_s": 0.65, "load": 0.25}) == []
+
+
+def test_plots_per_type_drawn_from_the_runs_traces(results, tmp_path):
+    """Issue 29 item 5: one Fig. 4-style PNG per shift type (transmission8_plots.write_plots, what --plots writes),
+    drawn from traces that are the run's: trace_shift's quality dict is run_shift's, the quality's figures
+    recomputed from the traces agree with it, and the plant recorded the currents the TCU commanded."""
+    lib = t8._library()    # noqa: SLF001
+    assert sorted(k for _, _, k in t8.PLOT_CASES) == sorted(t8.TYPES.values())
+    traces = [t8.trace_shift("nominal", s, t, k, lib=lib) for s, t, k in t8.PLOT_CASES]
+    paths = t8_plots.write_plots(tmp_path / "plots", traces)
+    assert sorted(p.name for p in paths) == ["power-off-downshift.png", "power-off-upshift.png",
+                                             "power-on-downshift.png", "power-on-upshift.png"]
+    assert sorted((tmp_path / "plots").iterdir()) == sorted(paths)   # no temporary left behind
+    for path in paths:
+        data = path.read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000, (path, len(data))
+    for case, trace in zip(t8.PLOT_CASES, traces):
+        q = trace.quality
+        # the same run as run_shift's (the same seed): the same dict, NaN and the energy per element included
+        assert json.dumps(q, sort_keys=True) == json.dumps(results[case], sort_keys=True), case
+        truth, tcu, k0, end = trace.truth, trace.tcu, trace.request_index, trace.end_index
+        dt = truth["t_s"][1] - truth["t_s"][0]
+        assert end is not None and tcu["phase"].size == truth["t_s"].size - 1
+        window = slice(k0 + 1, end + round(0.2 / dt) + 1)      # the quality's: the request to 0.2 s after the end
+        jerk = np.gradient(_lowpass_zero_phase(truth["vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ), dt)
+        # rel 1e-9: dt here is the record's time step, the quality's the plant's period (equal to rounding)
+        assert float(np.max(np.abs(jerk[window]))) == pytest.approx(q["peak_jerk_m_s3"], rel=1e-9), case
+        assert (end - k0) * dt == pytest.approx(q["duration_s"], rel=1e-9)
+        on = trace.oncoming
+        assert float(np.max(tcu[f"{on}_theta_degC"][k0:])) == q["peak_theta_estimate_degC"]
+        assert float(np.max(truth[f"{on}_theta_degC"][window])) == q["peak_theta_truth_degC"]
+        # truth row k + 1 holds the currents of period k: the TCU's commands (within both's ranges: exact)
+        for e in t8.ELEMENTS:
+            assert np.array_equal(truth[f"{e}_current_mA"][1:], tcu[f"{e}_current_mA"]), (case, e)
+        assert trace.phase_changes()[0] == (k0, "prepare")
+        assert t8.PHASES[int(tcu["phase"][end])] == "locked" and "inertia" in dict(trace.phase_changes()).values()
+        assert q["oncoming"] == on != trace.offgoing
+
+
+def test_plots_option_and_exit_codes(monkeypatch, tmp_path):
+    """--plots: on with --matrix (OUT/plots) unless --no-plots; the matrix's exit code kept (1: a miss), 2 when a
+    plotted shift cannot run (run_matrix and run_plots stubbed: the wiring only)."""
+    calls = []
+    monkeypatch.setattr(t8, "run_matrix", lambda out, *a: calls.append(("matrix", out)) or 1)
+    monkeypatch.setattr(t8, "run_plots", lambda out, vehicle: calls.append(("plots", out, vehicle)) or [])
+    assert t8.main(["--matrix", "--out", str(tmp_path)]) == 1
+    assert calls == [("matrix", tmp_path), ("plots", tmp_path / "plots", "nominal")]
+    calls.clear()
+    assert t8.main(["--matrix", "--out", str(tmp_path), "--no-plots"]) == 1
+    assert calls == [("matrix", tmp_path)]
+
+    def refused(out, vehicle):
+        raise t8.ShiftError("refused")
+    monkeypatch.setattr(t8, "run_plots", refused)
+    assert t8.main(["--matrix", "--out", str(tmp_path)]) == 2
+    monkeypatch.setattr(t8, "run_matrix", lambda out, *a: 0)
+    assert t8.main(["--matrix", "--out", str(tmp_path)]) == 2
