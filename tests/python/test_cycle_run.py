@@ -134,3 +134,34 @@ def test_the_type_the_request_assumes_is_the_firmwares():
     assert runner._kind(-1, value) == "power-off downshift"
     assert runner._kind(-1, value + 1.0) == "power-on downshift"
     assert runner._kind(+1, 1.0) == "power-on upshift"
+
+
+def _fake(shifts, scales):
+    """A CycleResult with these shifts (t_s, shift, peak jerk) and every element's friction scales."""
+    values = {e: {"friction_scale": list(scales), "confidence": [0.5] * 5, "film_factor": 1.0, "kiss_offset_Pa": 0.0,
+                  "shifts_learned": 3} for e in runner.ELEMENTS}
+    qs = [{"t_s": t, "shift": s, "peak_jerk_m_s3": j, "missed": []} for t, s, j in shifts]
+    return runner.CycleResult("fake", None, {}, qs, [], [], 0.0, 0, True, values)
+
+
+def test_the_adaptation_targets_are_judged():
+    """Issue 31's adaptation targets from the chained cycles: bands, settling from cycle 2 to 3 (the per-shift
+    steps of tools/calibrations/shift_1_2.toml: scale 0.05), no shift more than 2 % worse in cycle 1."""
+    from wetclutch.cycle.report import adaptation_figures
+    ref = _fake([(10.0, "1->2", 5.0), (20.0, "2->3", 4.0)], [1.0] * 5)
+    good = [_fake([(10.2, "1->2", 5.05), (20.1, "2->3", 3.0)], [1.02] * 5), _fake([], [1.03] * 5),
+            _fake([], [1.04] * 5)]
+    assert adaptation_figures(ref, good)["missed"] == []
+    worse = [_fake([(10.2, "1->2", 5.3), (20.1, "2->3", 3.0)], [1.02] * 5), *good[1:]]
+    a = adaptation_figures(ref, worse)
+    assert a["worse_in_cycle_1"] == [(10.2, "1->2", 5.0, 5.3)] and len(a["missed"]) == 1
+    drifting = [good[0], _fake([], [1.10] * 5), _fake([], [1.20] * 5)]
+    assert any("not settled" in m for m in adaptation_figures(ref, drifting)["missed"])
+    outside = [good[0], good[1], _fake([], [1.35] * 5)]
+    assert any("outside their bands" in m for m in adaptation_figures(ref, outside)["missed"])
+    assert any("3 needed" in m for m in adaptation_figures(ref, good[:2])["missed"])
+
+
+def test_a_bad_adaptation_count_is_an_input_error(tmp_path, capsys):
+    assert cli.main(["cycle", "--adaptation", "11", "--out", str(tmp_path)]) == 2
+    assert "--adaptation 11" in capsys.readouterr().err
