@@ -36,6 +36,8 @@ static const wc_calibration_t wc_table1_calibration = {
     .breakaway_slip_rad_s = 0.8f, /* rad/s; project default: breakaway band 7.6 rpm (hysteresis above the lock band) */
     .lock_dwell_periods = 10u, /* 1; project default: 10 control periods (10 ms) inside the lock band before locking */
     .holding_margin = 0.2f, /* 1; project default: a locked clutch is held at 1.2 times the force the request needs */
+    .open_clearance_m = 0.0f, /* m; not in the file: 0, off (the open element's drag as the film's, DESIGN 15) */
+    .open_aeration_speed_rad_s = 0.0f, /* rad/s; not in the file: 0, off (the open element's drag as the film's, DESIGN 15) */
     .heat_capacity_J_per_K = 287.30515f, /* J/K; eq. 1: N_c((m c_p)_lining + (m c_p)_separator) from the thermal section */
     .film = { wc_table1_film_pressure_Pa, wc_table1_film_hbar_m, wc_table1_film_slope_m_per_Pa, WC_TABLE1_FILM_NODES },
 };

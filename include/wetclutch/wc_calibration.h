@@ -46,6 +46,10 @@ typedef struct {
     float breakaway_slip_rad_s;        /* |slip| above it while locked: breakaway (> lock_slip_rad_s) */
     float holding_margin;              /* a locked clutch is held at (1 + margin) times the request's force */
     uint32_t lock_dwell_periods;       /* control periods inside the lock band before locking */
+    /* The open element's drag (DESIGN 15): with the piston retracted (modelled apply force P A_p - F_s <= 0)
+     * the viscous term shears the retracted stroke's clearance too, and the open pack's aeration lowers it */
+    float open_clearance_m;            /* retracted piston's stroke per gap, x_s / N_c, added to h_bar; 0: off */
+    float open_aeration_speed_rad_s;   /* w_a: open drag / (1 + (slip / w_a)^2); 0: off */
     wc_film_table_t film;
 } wc_calibration_t;
 
@@ -87,6 +91,8 @@ typedef enum {
     WC_CAL_BREAKAWAY_SLIP,      /* also: not above the lock band */
     WC_CAL_HOLDING_MARGIN,
     WC_CAL_LOCK_DWELL,
+    WC_CAL_OPEN_CLEARANCE,
+    WC_CAL_OPEN_AERATION_SPEED, /* neither 0 (off) nor in [WC_CAL_LIMIT_OPEN_AERATION_SPEED_MIN_rad_s, ..._MAX_rad_s] */
     WC_CAL_FILM_TABLE,          /* missing arrays, bad length, non-finite entry */
     WC_CAL_FILM_AXIS_NOT_MONOTONE,
     WC_CAL_CONDUCTANCE_SUM,     /* k1 + k2 below WC_CAL_LIMIT_CONDUCTANCE_SUM_MIN_W_per_K */
@@ -193,6 +199,15 @@ typedef enum {
 #define WC_CAL_LIMIT_HOLDING_MARGIN_MAX 1.0f
 /* Lock dwell 1..255 periods: the firmware counts it in 8 bits. */
 #define WC_CAL_LIMIT_LOCK_DWELL_MAX_periods 255u
+/* The open element's drag (DESIGN 15). Clearance in [0, 5e-3] m per gap (0: off): a retracted piston's
+ * stroke over the pack's gaps is 0.1..0.5 mm, 5 mm more than any pack's whole stroke; h_bar + the
+ * clearance is finite and >= h_bar, so the viscous term only falls. Aeration speed 0 (off) or in
+ * [1, 1e4] rad/s (measured open packs' drag peaks at 100..200 rad/s; the bounds leave room for the
+ * equivalent clutch of a shift, w_a / |a|, wc_transmission.c): (slip / w_a)^2 <= (WC_SLIP_MAX_rad_s)^2
+ * ~ 1.1e6, so the factor 1 / (1 + (slip / w_a)^2) lies in (0, 1]. */
+#define WC_CAL_LIMIT_OPEN_CLEARANCE_MAX_m 5e-3f
+#define WC_CAL_LIMIT_OPEN_AERATION_SPEED_MIN_rad_s 1.0f
+#define WC_CAL_LIMIT_OPEN_AERATION_SPEED_MAX_rad_s 1e4f
 
 /* Check every field against the limits above, and the relations between
  * fields that the equations need (DESIGN section 8): radii ordered, mu_v and

@@ -19,8 +19,8 @@
  * dynamics with the turbine torque -T_t >= 0, DESIGN 15); the engine request
  * it returns is negated back. The controller's clutches are
  * the on-coming and off-going elements as equivalent clutches in the
- * controller's coordinates (slip / a): radii x |a| and the squeeze-film
- * factor / a^4, so that the model's torque is |a| x the element's and its
+ * controller's coordinates (slip / a): radii x |a|, the squeeze-film
+ * factor / a^4 and the open drag's aeration speed / |a|, so that the model's torque is |a| x the element's and its
  * sliding speed, film, friction and heat the element's own
  * (tools/wetclutch/shift/matrix8.py states the derivation); the element's
  * state (temperature, pressure, film, lock-up) carries over both ways.

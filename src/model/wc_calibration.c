@@ -82,7 +82,10 @@ static float smaller(float a, float b) { return (a < b) ? a : b; }
     X(lock_slip_rad_s, WC_CAL_LOCK_SLIP, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_LOCK_SLIP_MAX_rad_s) \
     X(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP, WC_FIELD_LOW_OPEN, 0.0f, WC_CAL_LIMIT_BREAKAWAY_SLIP_MAX_rad_s) \
     X(holding_margin, WC_CAL_HOLDING_MARGIN, 0u, WC_CAL_LIMIT_HOLDING_MARGIN_MIN, WC_CAL_LIMIT_HOLDING_MARGIN_MAX) \
-    X(lock_dwell_periods, WC_CAL_LOCK_DWELL, WC_FIELD_INTEGER, 1.0f, (float)WC_CAL_LIMIT_LOCK_DWELL_MAX_periods)
+    X(lock_dwell_periods, WC_CAL_LOCK_DWELL, WC_FIELD_INTEGER, 1.0f, (float)WC_CAL_LIMIT_LOCK_DWELL_MAX_periods) \
+    X(open_clearance_m, WC_CAL_OPEN_CLEARANCE, 0u, 0.0f, WC_CAL_LIMIT_OPEN_CLEARANCE_MAX_m) \
+    X(open_aeration_speed_rad_s, WC_CAL_OPEN_AERATION_SPEED, WC_FIELD_OR_ZERO, \
+      WC_CAL_LIMIT_OPEN_AERATION_SPEED_MIN_rad_s, WC_CAL_LIMIT_OPEN_AERATION_SPEED_MAX_rad_s)
 
 #define WC_CAL_RANGE(member, code, flags, low, high) { (low), (high) },
 #define WC_CAL_FLAGS(member, code, flags, low, high) (uint8_t)(flags),
@@ -96,7 +99,7 @@ static const uint8_t field_flags[] = { WC_CAL_FIELD_RANGES(WC_CAL_FLAGS) };
 static const wc_field_rules_t field_rules = { field_range, field_flags, sizeof field_flags };
 WC_CAL_FIELD_RANGES(WC_CAL_AT_ITS_CODE)
 /* Every scalar field has its range: the last one is the last before the film table. */
-WC_STATIC_ASSERT(sizeof field_flags == (size_t)(WC_CAL_LOCK_DWELL - WC_CAL_OUTER_RADIUS + 1), one_range_per_code);
+WC_STATIC_ASSERT(sizeof field_flags == (size_t)(WC_CAL_OPEN_AERATION_SPEED - WC_CAL_OUTER_RADIUS + 1), one_range_per_code);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == sizeof field_flags * 4u, every_scalar_field_has_a_range);
 WC_STATIC_ASSERT((sizeof(float) == 4u) && (sizeof(uint32_t) == 4u), fields_are_words);
 
@@ -281,6 +284,8 @@ static const char *const cal_error_names[] = {
     "breakaway_slip_rad_s",
     "holding_margin",
     "lock_dwell_periods",
+    "open_clearance_m",
+    "open_aeration_speed_rad_s",
     "film (table arrays, length or entries)",
     "film.pressure_Pa (not strictly increasing)",
     "oil_conductance_W_per_K + housing_conductance_W_per_K",

@@ -115,6 +115,24 @@ static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, f
     (void)wc_vfs_current_mA(cal, kiss_pressure_Pa(cal, force_N, kiss_offset_N), &inv->current_mA);
 }
 
+/* DESIGN 15, the open element's drag: with the piston retracted (open: its modelled apply force 0) the
+ * viscous term shears the film h_bar plus the retracted stroke's clearance per gap, and the open pack's
+ * aeration divides it by 1 + (slip / w_a)^2. As a gap: (h_bar + clearance) (1 + (slip / w_a)^2), h_bar
+ * <= 1 mm, clearance <= 5 mm, the factor in [1, 1.1e6] (the calibration's limits, |slip| <= WC_SLIP_MAX_rad_s):
+ * finite, >= h_bar, so the torque stays finite and only falls. Off (both 0) or applied: h_bar, bit for bit. */
+static inline float open_gap_m(const wc_calibration_t *cal, float hbar_m, bool open, float slip_rad_s)
+{
+    float gap_m = hbar_m;
+    if (open) {
+        gap_m += cal->open_clearance_m;
+        if (cal->open_aeration_speed_rad_s > 0.0f) {
+            const float aeration = slip_rad_s / cal->open_aeration_speed_rad_s;
+            gap_m *= 1.0f + aeration * aeration;
+        }
+    }
+    return gap_m;
+}
+
 /* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
 static bool nonzero(float x) { return (x < 0.0f) || (x > 0.0f); }
 
@@ -225,6 +243,8 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
+    /* DESIGN 15: the piston retracted, its modelled apply force P A_p - F_s (before the learned kiss offset) 0 */
+    bool open = !(force_N > 0.0f);
     if (corrected && nonzero(correction.kiss_offset_N)) {
         /* DESIGN 12: the learned kiss point moves the spring's preload: F = P A_p - F_s - offset, within
          * [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
@@ -238,7 +258,10 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
                               wc_in_range(in->bench.torque_Nm, -WC_TORQUE_MAX_Nm, WC_TORQUE_MAX_Nm);
     if (in->bench.valid && !bench_force) { status |= WC_STATUS_FORCE_INVALID; }
     if (in->bench.valid && !bench_torque) { status |= WC_STATUS_TORQUE_INVALID; }
-    if (bench_force) { force_N = in->bench.apply_force_N; }
+    if (bench_force) {
+        force_N = in->bench.apply_force_N;
+        open = !(force_N > 0.0f);  /* a bench's load cell measures the apply force itself */
+    }
     /* valid: the modelled force is in [0, F_max] (F_max <= WC_FORCE_MAX_N by the
      * calibration check), the bench force was range-checked above */
     const wc_calibration_t *cal = model->cal;
@@ -252,13 +275,19 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
          * squeeze film carries the rest, and the film advances under the force. */
         const float contact_N = cal->friction_area_m2 * contact.pressure_Pa;
-        wc_torque_at_film(&point, signed_slip_rad_s, contact_N, hbar_m, &out->model);
+        wc_torque_at_gap(&point, signed_slip_rad_s, contact_N, hbar_m, open_gap_m(cal, hbar_m, open, u->slip_rad_s),
+                         &out->model);
         out->contact_force_N = contact_N;
         clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
                                                    damping_N_s_m2,
                                                    cal->control_period_s, film_segment);
     } else {
-        wc_torque_at_point(model, &point, signed_slip_rad_s, force_N, &out->model);  /* eq. 16: the paper's steady film */
+        /* eq. 16: the paper's steady film (the modelled force lags the commanded one: no segment to start
+         * from that would hold in the worst case) */
+        const float steady_hbar_m =
+            wc_film_hbar_near_m(&cal->film, force_N / cal->friction_area_m2, WC_FILM_NO_SEGMENT);
+        wc_torque_at_gap(&point, signed_slip_rad_s, force_N, steady_hbar_m,
+                         open_gap_m(cal, steady_hbar_m, open, u->slip_rad_s), &out->model);
         out->contact_force_N = force_N;
     }
 

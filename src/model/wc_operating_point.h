@@ -53,16 +53,25 @@ static inline float wc_static_capacity_Nm_per_N(const wc_model_t *model, const w
 }
 
 /* eq. 5-8 at the point for a contact force and the film it stands on (the
- * steady film of eq. 16, or the squeeze-film state of DESIGN 9). */
-static inline void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N,
-                                     float hbar_m, wc_torque_t *out)
+ * steady film of eq. 16, or the squeeze-film state of DESIGN 9), the viscous
+ * term sheared over gap_m: the film h_bar itself, or an open element's gap
+ * (DESIGN 15, wc_clutch.c); out->hbar_m is the film's. */
+static inline void wc_torque_at_gap(const wc_torque_point_t *point, float slip_rad_s, float force_N,
+                                    float hbar_m, float gap_m, wc_torque_t *out)
 {
     const float sign = (slip_rad_s < 0.0f) ? -1.0f : 1.0f;  /* torque acts against the slip */
     out->coulomb_Nm = sign * point->coulomb_Nm_per_N * force_N;   /* eq. 6 */
-    out->viscous_Nm = sign * point->viscous_Nm_m / hbar_m;        /* eq. 7 */
+    out->viscous_Nm = sign * point->viscous_Nm_m / gap_m;         /* eq. 7 */
     out->torque_Nm = out->coulomb_Nm + out->viscous_Nm;           /* eq. 5 */
     out->hbar_m = hbar_m;
     out->mu_f = point->mu_f;
+}
+
+/* eq. 5-8 at the point for a contact force and the film it stands on. */
+static inline void wc_torque_at_film(const wc_torque_point_t *point, float slip_rad_s, float force_N,
+                                     float hbar_m, wc_torque_t *out)
+{
+    wc_torque_at_gap(point, slip_rad_s, force_N, hbar_m, hbar_m, out);
 }
 
 /* Segment k of the film table (nodes k, k+1) as a cubic in t in [0, 1]

@@ -31,12 +31,14 @@ static void make_equivalent(const wc_calibration_t *element, float slip_scale, w
     /* DESIGN 15 (matrix8.py): the radii x |a| make R_eff (eq. 3) and with it the torque arm and the static
      * capacity x |a| while the sliding speed R_eff |slip / a| (eq. 4), and so mu_f (eq. 18), the viscous term
      * (eq. 5-8) and eq. 1's power, stay the element's; the squeeze film's Reynolds factor is of degree 4 in
-     * the radii (wc_model.c). Forces, pressures, areas and the heat capacity are the element's. */
+     * the radii (wc_model.c); the open drag's aeration speed is a slip, / |a| in these coordinates (0 stays
+     * off). Forces, pressures, areas, the open clearance and the heat capacity are the element's. */
     const float s = fabsf(slip_scale);
     *out = *element;
     out->outer_radius_m = element->outer_radius_m * s;
     out->inner_radius_m = element->inner_radius_m * s;
     out->film_squeeze_factor = element->film_squeeze_factor / (s * s * s * s);
+    out->open_aeration_speed_rad_s = element->open_aeration_speed_rad_s / s;
 }
 
 wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float slip_scale, wc_calibration_t *out)

@@ -144,6 +144,12 @@ static const variant_t rejected_variants[] = {
     V1(WC_CAL_BREAKAWAY_SLIP, breakaway_slip_rad_s, 0.3f),          /* == the lock band: no hysteresis */
     V1(WC_CAL_HOLDING_MARGIN, holding_margin, 0.0f),                /* no torque hysteresis */
     V1(WC_CAL_HOLDING_MARGIN, holding_margin, 1.5f),
+    /* the open element's drag (DESIGN 15): clearance 0..5 mm, aeration speed 0 (off) or 1..1e4 rad/s */
+    V1(WC_CAL_OPEN_CLEARANCE, open_clearance_m, -1e-6f),
+    V1(WC_CAL_OPEN_CLEARANCE, open_clearance_m, 6e-3f),
+    V1(WC_CAL_OPEN_AERATION_SPEED, open_aeration_speed_rad_s, -1.0f),
+    V1(WC_CAL_OPEN_AERATION_SPEED, open_aeration_speed_rad_s, 0.5f),   /* neither off nor a speed */
+    V1(WC_CAL_OPEN_AERATION_SPEED, open_aeration_speed_rad_s, 2e4f),
     /* relations of several fields */
     V2(WC_CAL_CONDUCTANCE_SUM, oil_conductance_W_per_K, 1e-40f, housing_conductance_W_per_K, 0.0f),  /* issue 10 */
     V2(WC_CAL_CONDUCTANCE_SUM, oil_conductance_W_per_K, 5e-4f, housing_conductance_W_per_K, 4e-4f),
@@ -190,6 +196,12 @@ static const variant_t accepted_variants[] = {
     V1(WC_CAL_OK, vfs_current_max_mA, 1400.0f),
     V1(WC_CAL_OK, control_period_s, 1e-4f),
     V1(WC_CAL_OK, control_period_s, 0.1f),
+    V1(WC_CAL_OK, open_clearance_m, 1.875e-4f),             /* 1.5 mm over 8 gaps */
+    V1(WC_CAL_OK, open_clearance_m, 5e-3f),
+    V1(WC_CAL_OK, open_aeration_speed_rad_s, 1.0f),         /* the strongest aeration: slip / w_a up to 1047 */
+    V1(WC_CAL_OK, open_aeration_speed_rad_s, 157.08f),      /* 1500 rpm */
+    V1(WC_CAL_OK, open_aeration_speed_rad_s, 1e4f),
+    V2(WC_CAL_OK, open_clearance_m, 5e-3f, open_aeration_speed_rad_s, 1.0f),
     V2(WC_CAL_OK, viscosity_a1_Pa_s, 0.0f, viscosity_b1_per_K, 0.3f),
     V2(WC_CAL_OK, viscosity_a1_Pa_s, 0.0f, viscosity_b1_per_K, -0.3f),
     V2(WC_CAL_OK, theta2_K, 1.0f, mu3, 0.0f),

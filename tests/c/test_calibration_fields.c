@@ -43,8 +43,8 @@ static void test_field_table_is_complete(void **state)
 {
     (void)state;
     const size_t n = WC_TEST_COUNT(float_fields);
-    /* 30 scalar fields in wc_calibration_t: 28 float + friction_pairs and lock_dwell_periods (uint32). */
-    assert_int_equal(n, 28);
+    /* 32 scalar fields in wc_calibration_t: 30 float + friction_pairs and lock_dwell_periods (uint32). */
+    assert_int_equal(n, 30);
     for (size_t i = 0u; i < n; ++i) {
         for (size_t j = i + 1u; j < n; ++j) {
             WC_CHECK(float_fields[i].offset != float_fields[j].offset, "%s twice", float_fields[i].name);
@@ -54,10 +54,11 @@ static void test_field_table_is_complete(void **state)
                  float_fields[i].name);
     }
     /* Float fields, friction_pairs and lock_dwell_periods fill the struct up to film (after padding to
-     * the pointers' alignment). */
-    assert_int_equal(n * sizeof(float) + sizeof(uint32_t), offsetof(wc_calibration_t, lock_dwell_periods));
-    assert_true(offsetof(wc_calibration_t, film) - offsetof(wc_calibration_t, lock_dwell_periods) <=
-                sizeof(uint32_t) + sizeof(void *));
+     * the pointers' alignment); the open drag's two floats come after lock_dwell_periods. */
+    assert_int_equal((n - 2u) * sizeof(float) + sizeof(uint32_t), offsetof(wc_calibration_t, lock_dwell_periods));
+    assert_int_equal(offsetof(wc_calibration_t, open_aeration_speed_rad_s) + sizeof(float),
+                     (n + 2u) * sizeof(float));
+    assert_true(offsetof(wc_calibration_t, film) - (n + 2u) * sizeof(float) < sizeof(void *));
 }
 
 /* NaN and +-Inf in any field: that field's code (every rule rejects them). */
@@ -124,6 +125,13 @@ static void test_limits_are_inclusive(void **state)
         LIMIT(vfs_current_max_mA, WC_CAL_LIMIT_CURRENT_MAX_mA, INFINITY, WC_CAL_VFS_CURRENT_MAX),
         LIMIT(control_period_s, WC_CAL_LIMIT_CONTROL_PERIOD_MIN_s, -INFINITY, WC_CAL_CONTROL_PERIOD),
         LIMIT(control_period_s, WC_CAL_LIMIT_CONTROL_PERIOD_MAX_s, INFINITY, WC_CAL_CONTROL_PERIOD),
+        LIMIT(open_clearance_m, 0.0f, -INFINITY, WC_CAL_OPEN_CLEARANCE),
+        LIMIT(open_clearance_m, WC_CAL_LIMIT_OPEN_CLEARANCE_MAX_m, INFINITY, WC_CAL_OPEN_CLEARANCE),
+        /* 0 is off; between 0 and the minimum neither off nor on */
+        LIMIT(open_aeration_speed_rad_s, WC_CAL_LIMIT_OPEN_AERATION_SPEED_MIN_rad_s, -INFINITY,
+              WC_CAL_OPEN_AERATION_SPEED),
+        LIMIT(open_aeration_speed_rad_s, WC_CAL_LIMIT_OPEN_AERATION_SPEED_MAX_rad_s, INFINITY,
+              WC_CAL_OPEN_AERATION_SPEED),
     };
     for (size_t i = 0u; i < WC_TEST_COUNT(limits); ++i) {
         const limit_t *l = &limits[i];

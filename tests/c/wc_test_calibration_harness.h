@@ -108,6 +108,8 @@ static const float_field_t float_fields[] = {
     FIELD(lock_slip_rad_s, WC_CAL_LOCK_SLIP),
     FIELD(breakaway_slip_rad_s, WC_CAL_BREAKAWAY_SLIP),
     FIELD(holding_margin, WC_CAL_HOLDING_MARGIN),
+    FIELD(open_clearance_m, WC_CAL_OPEN_CLEARANCE),
+    FIELD(open_aeration_speed_rad_s, WC_CAL_OPEN_AERATION_SPEED),
 };
 
 #endif /* WC_TEST_CALIBRATION_HARNESS_H */

@@ -11,7 +11,7 @@
  *           that many floats so that AddressSanitizer sees any read past the
  *           end; bits 3-4 == 3: one of the three pointers NULL (bits 5-6).
  *   then edits until the bytes run out (at most MAX_EDITS): a target byte
- *   (one of the 28 float fields, friction_pairs, or a node of the film's
+ *   (one of the 30 float fields, friction_pairs, or a node of the film's
  *   pressure / h_bar / slope array, index in one more byte) and a mutation
  *   (raw float bits, a special or in-range value, a factor 2^(k/8), a
  *   perturbation by up to 3 %, a negation, some ulps up or down).
@@ -93,7 +93,7 @@ static const float_field_t float_fields[] = {
     FIELD(vfs_gain_Pa_per_mA), FIELD(vfs_time_constant_s), FIELD(return_spring_force_N),
     FIELD(vfs_current_min_mA), FIELD(vfs_current_max_mA), FIELD(control_period_s),
     FIELD(film_squeeze_factor), FIELD(static_friction_factor), FIELD(lock_slip_rad_s), FIELD(breakaway_slip_rad_s),
-    FIELD(holding_margin),
+    FIELD(holding_margin), FIELD(open_clearance_m), FIELD(open_aeration_speed_rad_s),
 };
 #undef FIELD
 #define N_FLOAT_FIELDS (sizeof float_fields / sizeof float_fields[0])

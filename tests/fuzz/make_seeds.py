@@ -108,7 +108,7 @@ FLOAT_FIELDS = [
     "viscosity_a2_Pa_s", "viscosity_b2_per_K", "mu1", "mu2", "mu3", "stribeck_speed_m_s", "theta1_degC",
     "theta2_K", "vfs_gain_Pa_per_mA", "vfs_time_constant_s", "return_spring_force_N", "vfs_current_min_mA",
     "vfs_current_max_mA", "control_period_s", "film_squeeze_factor", "static_friction_factor", "lock_slip_rad_s",
-    "breakaway_slip_rad_s", "holding_margin",
+    "breakaway_slip_rad_s", "holding_margin", "open_clearance_m", "open_aeration_speed_rad_s",
 ]
 
 

@@ -67,7 +67,7 @@ def test_layout_is_the_c_headers():
     assert f"WC_CAL_IMAGE_PAYLOAD_MAX_BYTES {layout.PAYLOAD_MAX_BYTES}u" in header
     generated = (ROOT / cal_image_layout.HEADER).read_text()
     assert f"#define WC_CAL_IMAGE_PAYLOAD_BYTES {layout.payload_bytes()}u" in generated
-    assert layout.payload_bytes() == 1160   # 1088 + the whole shift's 18 words (DESIGN 14)
+    assert layout.payload_bytes() == 1168   # 1088 + the whole shift's 18 words (DESIGN 14) + the open drag's 2 (DESIGN 15)
     # the loop's codes: one per loop field, in the layout's order, with the layout's limits in their comment
     codes = re.findall(r"WC_CAL_LOOP_[A-Z_]+,\s*/\* (\S+) (?:outside (\d+)\.\.(\d+)|neither 0 nor 1)", header)
     loop = [f for f in layout.FIELDS if f.group == "loop"]
@@ -135,7 +135,7 @@ def test_golden_vector_is_current():
 def test_round_trip_and_reader_rules():
     values = cal_image.build(TABLE1, shift_variant="shift_1_2_full", loop={"sync_counter": 4})
     image = cal_image.write_image_bytes(values)
-    assert len(image) == cal_image.IMAGE_BYTES == 1180
+    assert len(image) == cal_image.IMAGE_BYTES == 1188
     assert cal_image.read_image(image) == values
     assert values["loop.e2e.sync_counter"] == 4 and values["loop.shift_enabled"] == 1
     off = cal_image.build(TABLE1)

@@ -36,6 +36,7 @@ SOURCE = ROOT / "src" / "model" / "wc_calibration.c"
 C_TEST = ROOT / "tests" / "c" / "test_calibration.c"
 
 SECTION = {name: section for section, name, *_ in calibration.PARAMETERS}
+UNIT = {name: unit for _, name, unit, *_ in calibration.PARAMETERS}
 BY_FIELD = {field: (section, name) for section, name, _, _, field in calibration.PARAMETERS if field}
 
 
@@ -70,10 +71,15 @@ def c_variants(array: str) -> list[tuple[str, list[tuple[str, float]]]]:
 
 
 def toml_text(changes: dict[str, str], base: Path = TABLE1) -> str:
-    """table1 with some values replaced (name -> TOML value text)."""
+    """table1 with some values replaced (name -> TOML value text); an optional parameter the file leaves out
+    (calibration.OPTIONAL) added to its section."""
     text = base.read_text()
     for name, value in changes.items():
         text, count = re.subn(rf"(^{name} *= \{{ value = )[^,]+", rf"\g<1>{value}", text, count=1, flags=re.M)
+        if count == 0 and name in calibration.OPTIONAL:
+            unit = UNIT[name]
+            text, count = re.subn(rf"^\[{SECTION[name]}\]\s*$", rf'[{SECTION[name]}]\n{name} = {{ value = {value},'
+                                  rf' unit = "{unit}", source = "test" }}', text, count=1, flags=re.M)
         assert count == 1, name
     return text
 
@@ -160,7 +166,7 @@ ACCEPTED = c_variants("accepted_variants")
 def test_variant_lists_parsed():
     assert len(REJECTED) >= 70 and len(ACCEPTED) >= 35
     fields = {f for _, settings in REJECTED for f, _ in settings}
-    assert len(fields) == 28      # every float field of wc_calibration_t has a rejected variant
+    assert len(fields) == 30      # every float field of wc_calibration_t has a rejected variant
 
 
 def _label(settings):

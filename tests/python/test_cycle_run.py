@@ -69,22 +69,21 @@ def test_every_request_engages(low):
 @pytest.mark.xfail(strict=True, reason="missed (2026-11-29): 6 of 74 shifts of the low phase end in lock-up failed:"
                    " five coast downshifts (2->1, 3->2, 4->3; four with the engine still pulling, 5..31 N*m) flare"
                    " 131..469 rpm, three of them on the open converter (the lock-up not yet closed again after the"
-                   " shift before: the TCU's reduced model has it closed); one 4->5 upshift at 8 N*m (tie-up 36 %)")
+                   " shift before: the TCU's reduced model has it closed); one 4->5 upshift at 8 N*m")
 def test_every_shift_completes(low):
     assert [q for q in low[3] if q["abort"] != 0] == []
 
 
-@pytest.mark.xfail(strict=True, reason="missed (2026-11-29): 26 of 74 shifts meet every limit of issue 29; misses:"
+@pytest.mark.xfail(strict=True, reason="missed (2026-11-29): 37 of 74 shifts meet every limit of issue 29; misses:"
                    " tie-up 27 (light-load upshifts: > 10 % of T_t, at least 20 N*m; the on-coming element's fill"
-                   " overshoot), theta 19, inertia 11, jerk 8, flare 8, not completed 6")
+                   " overshoot), inertia 11, jerk 11, flare 8, not completed 6")
 def test_every_shift_within_the_limits(low):
     assert [(q["t_s"], q["shift"], q["missed"]) for q in low[3] if q["missed"]] == []
 
 
-@pytest.mark.xfail(strict=True, reason="missed (2026-11-29): the observer of an open element runs up to 49 K above"
-                   " its truth (A 48.5, B 35.7, D 19.3 K): the TCU's open element drags through h_bar(0), the"
-                   " plant's through its piston's clearance with aeration")
 def test_the_observer_within_5_K_of_every_element(low):
+    # (met since the open element's clearance and aeration are calibration fields: A 0.9, B 0.1, C 1.3, D 1.6,
+    # E 1.4 K over the low phase; up to 48.5 K before)
     assert max(low[2]["observer_max_error_K"].values()) <= 5.0
 
 

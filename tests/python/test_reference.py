@@ -1,6 +1,8 @@
 """The double-precision reference model against DESIGN.md section 2 and against physics."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -119,3 +121,32 @@ def test_thermal_exact_discretization_matches_ode_solver(cal):
         expected[a:b] = sol.y[0][:-1]
         y0 = sol.y[0][-1]
     assert np.max(np.abs(theta - expected)) < 1e-6
+
+
+@pytest.mark.parametrize("element", ["A", "B", "D"])
+def test_open_drag_is_the_8speed_plants(element):
+    """DESIGN 15: the reference's open element (torque_parts, open_element=True: the gap (h_bar +
+    open_clearance) (1 + (slip / w_a)^2)) with tools/gearboxes/8hp.toml's open drag is the 8-speed plant's
+    viscous drag of an open element (gearbox_plant/element.py, fill 0: the piston's stroke over N_c gaps and the
+    aeration speed of the plant files). Same formula in double: 1e-12 relative. Without the open drag the
+    reference's film alone drags 7 to 100 times more."""
+    from wetclutch import gearbox
+    from wetclutch.simulate.gearbox_plant.element import TrueElement
+    gb = gearbox.load(Path(__file__).resolve().parents[2] / "tools" / "gearboxes" / "8hp.toml")
+    cal = gb.element(element).calibration
+    stroke_m, aeration = 1.5e-3, 1500.0 * model.RAD_S_PER_RPM   # nominal.toml fill, 8hp/nominal.toml aeration
+    assert cal.open_clearance == pytest.approx(stroke_m / cal.friction_pairs, rel=1e-5)
+    assert cal.open_aeration_speed == pytest.approx(aeration, rel=1e-5)
+    ref_cal = cal.with_values(open_aeration_speed=aeration, open_clearance=stroke_m / cal.friction_pairs)
+    truth = TrueElement(element, ref_cal,
+                        friction_scale=1.0, oil_degC=60.0, housing_degC=60.0, fill_rate_gain=1.0, fill_rate_max=1.0,
+                        stroke_m=stroke_m, aeration_speed=aeration, dt_s=1e-3, substeps=4)
+    assert truth.fill == 0.0
+    for rpm in (20.0, 150.0, 1000.0, 1500.0, 4000.0, -1500.0):
+        w = abs(rpm) * model.RAD_S_PER_RPM
+        plant = truth.visc_c * w / (1.0 + truth.aer_q * w * w)
+        parts = model.torque_parts(ref_cal, rpm, 60.0, 0.0, open_element=True)
+        assert abs(float(parts["viscous_Nm"])) == pytest.approx(plant, rel=1e-12)
+        assert np.sign(float(parts["viscous_Nm"])) == np.sign(rpm)
+        film = model.torque_parts(ref_cal, rpm, 60.0, 0.0)
+        assert 7.0 < float(film["viscous_Nm"]) / float(parts["viscous_Nm"]) < 100.0

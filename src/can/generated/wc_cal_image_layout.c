@@ -44,6 +44,8 @@ WC_STATIC_ASSERT(offsetof(wc_calibration_t, lock_slip_rad_s) == WC_CAL_IMAGE_OFF
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, breakaway_slip_rad_s) == WC_CAL_IMAGE_OFFSET_CLUTCH_BREAKAWAY_SLIP_RAD_S - WC_CAL_IMAGE_CLUTCH_BEGIN, clutch_breakaway_slip_rad_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, holding_margin) == WC_CAL_IMAGE_OFFSET_CLUTCH_HOLDING_MARGIN - WC_CAL_IMAGE_CLUTCH_BEGIN, clutch_holding_margin_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_calibration_t, lock_dwell_periods) == WC_CAL_IMAGE_OFFSET_CLUTCH_LOCK_DWELL_PERIODS - WC_CAL_IMAGE_CLUTCH_BEGIN, clutch_lock_dwell_periods_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_calibration_t, open_clearance_m) == WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_CLEARANCE_M - WC_CAL_IMAGE_CLUTCH_BEGIN, clutch_open_clearance_m_in_struct_order);
+WC_STATIC_ASSERT(offsetof(wc_calibration_t, open_aeration_speed_rad_s) == WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_AERATION_SPEED_RAD_S - WC_CAL_IMAGE_CLUTCH_BEGIN, clutch_open_aeration_speed_rad_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, turbine_inertia_kg_m2) == WC_CAL_IMAGE_OFFSET_SHIFT_TURBINE_INERTIA_KG_M2 - WC_CAL_IMAGE_SHIFT_BEGIN, shift_turbine_inertia_kg_m2_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, turbine_ratio) == WC_CAL_IMAGE_OFFSET_SHIFT_TURBINE_RATIO - WC_CAL_IMAGE_SHIFT_BEGIN, shift_turbine_ratio_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, output_inertia_kg_m2) == WC_CAL_IMAGE_OFFSET_SHIFT_OUTPUT_INERTIA_KG_M2 - WC_CAL_IMAGE_SHIFT_BEGIN, shift_output_inertia_kg_m2_in_struct_order);
@@ -101,7 +103,7 @@ WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_reduction_fraction) == 
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_recovery_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_RECOVERY_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_recovery_time_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, engine_lead_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_ENGINE_LEAD_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_engine_lead_time_s_in_struct_order);
 WC_STATIC_ASSERT(offsetof(wc_shift_calibration_t, fallback_time_s) == WC_CAL_IMAGE_OFFSET_SHIFT_FALLBACK_TIME_S - WC_CAL_IMAGE_SHIFT_BEGIN, shift_fallback_time_s_in_struct_order);
-WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == 120u, every_clutch_field_in_the_layout);
+WC_STATIC_ASSERT(offsetof(wc_calibration_t, film) == 128u, every_clutch_field_in_the_layout);
 WC_STATIC_ASSERT(sizeof(wc_shift_calibration_t) == 244u, every_shift_field_in_the_layout);
 
 void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
@@ -136,6 +138,8 @@ void wc_cal_image_layout_encode(const wc_cal_set_t *set, uint8_t *payload)
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_BREAKAWAY_SLIP_RAD_S], set->clutch.breakaway_slip_rad_s);
     wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_HOLDING_MARGIN], set->clutch.holding_margin);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_LOCK_DWELL_PERIODS], set->clutch.lock_dwell_periods);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_CLEARANCE_M], set->clutch.open_clearance_m);
+    wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_AERATION_SPEED_RAD_S], set->clutch.open_aeration_speed_rad_s);
     wc_image_put_u32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_LENGTH], set->clutch.film.length);
     for (uint32_t i = 0u; i < WC_CAL_IMAGE_FILM_NODES; ++i) {
         wc_image_put_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_PRESSURE_PA + 4u * i], set->film_pressure_Pa[i]);
@@ -245,6 +249,8 @@ void wc_cal_image_layout_decode(const uint8_t *payload, wc_cal_set_t *set)
     set->clutch.breakaway_slip_rad_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_BREAKAWAY_SLIP_RAD_S]);
     set->clutch.holding_margin = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_HOLDING_MARGIN]);
     set->clutch.lock_dwell_periods = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_LOCK_DWELL_PERIODS]);
+    set->clutch.open_clearance_m = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_CLEARANCE_M]);
+    set->clutch.open_aeration_speed_rad_s = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_AERATION_SPEED_RAD_S]);
     set->clutch.film.length = wc_image_get_u32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_LENGTH]);
     for (uint32_t i = 0u; i < WC_CAL_IMAGE_FILM_NODES; ++i) {
         set->film_pressure_Pa[i] = wc_image_get_f32(&payload[WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_PRESSURE_PA + 4u * i]);
@@ -368,6 +374,8 @@ static const field_name_t field_names[] = {
     { WC_CAL_IMAGE_OFFSET_CLUTCH_BREAKAWAY_SLIP_RAD_S, 4u, "clutch.breakaway_slip_rad_s" },
     { WC_CAL_IMAGE_OFFSET_CLUTCH_HOLDING_MARGIN, 4u, "clutch.holding_margin" },
     { WC_CAL_IMAGE_OFFSET_CLUTCH_LOCK_DWELL_PERIODS, 4u, "clutch.lock_dwell_periods" },
+    { WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_CLEARANCE_M, 4u, "clutch.open_clearance_m" },
+    { WC_CAL_IMAGE_OFFSET_CLUTCH_OPEN_AERATION_SPEED_RAD_S, 4u, "clutch.open_aeration_speed_rad_s" },
     { WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_LENGTH, 4u, "clutch.film.length" },
     { WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_PRESSURE_PA, 256u, "clutch.film.pressure_Pa" },
     { WC_CAL_IMAGE_OFFSET_CLUTCH_FILM_HBAR_M, 256u, "clutch.film.hbar_m" },

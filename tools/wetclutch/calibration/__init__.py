@@ -17,7 +17,8 @@ firmware's name for it (``wc_cal_error_name``).
 
 One module per concern, the clutch calibration's names importable from here (``calibration.load``):
 
-parameters   the Calibration type, the parameter table (PARAMETERS), the firmware's LIMITS and RANGES
+parameters   the Calibration type, the parameter table (PARAMETERS, the OPTIONAL ones a file may leave out), the
+             firmware's LIMITS and RANGES
 rules        the firmware's rules: one value, the relations between fields, the film table (film_problem)
 film_table   the h_bar(p_c) table a calibration gives the firmware: build, check, interpolate
 loader       load: TOML, units, sources, rules, film table
@@ -28,10 +29,10 @@ adaptation_image  the adaptation image: one clutch's learned values (wc_adapt_im
 from __future__ import annotations
 
 from .loader import load
-from .parameters import (C_NAMES, FILM_MAX_NODES, FORCE_MAX_N, LIMITS, PARAMETERS, RANGES, THETA_MAX_DEGC,
+from .parameters import (C_NAMES, FILM_MAX_NODES, FORCE_MAX_N, LIMITS, OPTIONAL, PARAMETERS, RANGES, THETA_MAX_DEGC,
                          THETA_MIN_DEGC, Calibration, CalibrationError, f32)
 from .rules import film_problem
 from .writer import render_calibration
 
-__all__ = ["C_NAMES", "FILM_MAX_NODES", "FORCE_MAX_N", "LIMITS", "PARAMETERS", "RANGES", "THETA_MAX_DEGC",
+__all__ = ["C_NAMES", "FILM_MAX_NODES", "FORCE_MAX_N", "LIMITS", "OPTIONAL", "PARAMETERS", "RANGES", "THETA_MAX_DEGC",
            "THETA_MIN_DEGC", "Calibration", "CalibrationError", "f32", "film_problem", "load", "render_calibration"]

@@ -110,6 +110,8 @@ _CLUTCH = (
     ("breakaway_slip_rad_s", "|slip| above it while locked: breakaway"),
     ("holding_margin", "a locked clutch is held at (1 + margin) times the request's force"),
     ("lock_dwell_periods", "control periods inside the lock band before locking"),
+    ("open_clearance_m", "open element: retracted stroke per gap added to h_bar; 0: off (DESIGN 15)"),
+    ("open_aeration_speed_rad_s", "open element: drag / (1 + (slip / this)^2); 0: off (DESIGN 15)"),
 )
 _TOML_NAME = {c_field: (name, unit, constraint) for _, name, unit, constraint, c_field in PARAMETERS if c_field}
 # Upper bounds the firmware sets by a relation only: the widest physical value.
@@ -128,6 +130,7 @@ _NOTES = {
     "vfs_current_max_mA": f"> vfs_current_min_mA; K i_max A_p in (F_s, {FORCE_MAX_N:g}] N",
     "film_squeeze_factor": f"0 or >= {LIMITS['FILM_SQUEEZE_FACTOR_MIN']:g}",
     "breakaway_slip_rad_s": "> lock_slip_rad_s",
+    "open_aeration_speed_rad_s": f"0 or >= {LIMITS['OPEN_AERATION_SPEED_MIN_rad_s']:g}",
 }
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..util.tomlfile import read_toml
 from . import film_table
-from .parameters import PARAMETERS, Calibration, CalibrationError
+from .parameters import OPTIONAL, OPTIONAL_SOURCE, PARAMETERS, Calibration, CalibrationError
 from .rules import _check_relations, _check_value
 
 
@@ -32,6 +32,9 @@ def from_document(doc: dict, path: str) -> Calibration:
     for section, name, unit, constraint, field in PARAMETERS:
         qualified = f"{section}.{name}"
         entry = doc.get(section, {}).get(name)
+        if entry is None and name in OPTIONAL:
+            values[name], sources[name] = OPTIONAL[name], OPTIONAL_SOURCE
+            continue
         if entry is None:
             raise CalibrationError(f"{path}: missing parameter '{qualified}' (unit {unit})")
         if not isinstance(entry, dict) or "value" not in entry:

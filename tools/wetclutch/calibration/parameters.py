@@ -55,10 +55,19 @@ PARAMETERS: tuple[tuple[str, str, str, str, str | None], ...] = (
     ("engagement", "breakaway_slip", "rad/s", "pos", "breakaway_slip_rad_s"),
     ("engagement", "lock_dwell", "1", "count", "lock_dwell_periods"),
     ("engagement", "holding_margin", "1", "nonneg", "holding_margin"),
+    ("engagement", "open_clearance", "m", "nonneg", "open_clearance_m"),
+    ("engagement", "open_aeration_speed", "rad/s", "nonneg", "open_aeration_speed_rad_s"),
     ("film_lut", "nodes", "1", "count", None),
     ("film_lut", "contact_pressure_max", "Pa", "pos", None),
     ("film_lut", "separation_max_sigma", "1", "pos", None),
 )
+
+
+# Parameters a file may leave out: their value then (0: off, the firmware's model without them) and the source
+# the loader records. The open element's drag (DESIGN 15; wc_calibration.h): a single clutch's file has no
+# retracted piston to describe, a gearbox's elements do (tools/gearboxes/8hp.toml).
+OPTIONAL: dict[str, float] = {"open_clearance": 0.0, "open_aeration_speed": 0.0}
+OPTIONAL_SOURCE = "not in the file: 0, off (the open element's drag as the film's, DESIGN 15)"
 
 
 # ---------------------------------------------------------------------------
@@ -103,6 +112,9 @@ LIMITS: dict[str, float] = {
     "LOCK_DWELL_MAX_periods": 255,               # the firmware counts the dwell in 8 bits
     "HOLDING_MARGIN_MIN": 0.05,                  # half of it is the lock-up's torque hysteresis
     "HOLDING_MARGIN_MAX": 1.0,                   # holding force up to twice the request's
+    "OPEN_CLEARANCE_MAX_m": 5e-3,                # open drag: retracted stroke per gap, 0 (off) .. 5 mm
+    "OPEN_AERATION_SPEED_MIN_rad_s": 1.0,        # open drag's aeration speed: 0 (off) or in [MIN, MAX]
+    "OPEN_AERATION_SPEED_MAX_rad_s": 1e4,
 }
 _L = LIMITS
 
@@ -154,7 +166,11 @@ RANGES: dict[str, tuple[float, bool, float | None]] = {
     "breakaway_slip": (0.0, False, _L["BREAKAWAY_SLIP_MAX_rad_s"]),    # and > lock_slip
     "lock_dwell": (1.0, True, _L["LOCK_DWELL_MAX_periods"]),
     "holding_margin": (_L["HOLDING_MARGIN_MIN"], True, _L["HOLDING_MARGIN_MAX"]),
+    "open_clearance": (0.0, True, _L["OPEN_CLEARANCE_MAX_m"]),
+    "open_aeration_speed": (0.0, True, _L["OPEN_AERATION_SPEED_MAX_rad_s"]),   # and 0 or >= the MIN
 }
+# Fields that are 0 (off) or at least their minimum (the firmware's WC_FIELD_OR_ZERO), checked with the range.
+OFF_OR_MIN: dict[str, float] = {"open_aeration_speed": _L["OPEN_AERATION_SPEED_MIN_rad_s"]}
 
 
 def f32(x: float) -> float:

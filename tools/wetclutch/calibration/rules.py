@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from .parameters import (C_NAMES, FILM_MAX_NODES, FORCE_MAX_N, RANGES, THETA_MAX_DEGC, THETA_MIN_DEGC, Calibration,
-                         CalibrationError, _L, f32)
+from .parameters import (C_NAMES, FILM_MAX_NODES, FORCE_MAX_N, OFF_OR_MIN, RANGES, THETA_MAX_DEGC, THETA_MIN_DEGC,
+                         Calibration, CalibrationError, _L, f32)
 
 
 def _range_text(low: float, low_in: bool, high: float | None) -> str:
@@ -39,6 +39,9 @@ def _check_value(path: str, qualified: str, raw: object, constraint: str, field:
         low, high = f32(low), (None if high is None else f32(high))
     if not ((checked >= low if low_in else checked > low) and (high is None or checked <= high)):
         raise CalibrationError(f"{where}: value {raw!r} must be in {_range_text(low, low_in, high)} {unit}")
+    if name in OFF_OR_MIN and checked != 0.0 and not checked >= f32(OFF_OR_MIN[name]):   # WC_FIELD_OR_ZERO
+        raise CalibrationError(f"{where}: value {raw!r} must be 0 (off) or in"
+                               f" {_range_text(OFF_OR_MIN[name], True, high)} {unit}")
     return value
 
 

@@ -15,7 +15,8 @@ tools/gearboxes/8hp.toml; DESIGN 15):
                                         with shafts = ["S1", "S2"]; slip = w_S (brake), w_S1 - w_S2 (clutch);
                                         calibration = path (optional, default clutch_calibration);
                                         [elements.NAME.overrides.SECTION] entries replace the calibration's
-                                        SECTION.entry (same { value, unit, source }, same checks)
+                                        SECTION.entry (same { value, unit, source }, same checks), or add an
+                                        optional one the file leaves out (calibration.parameters.OPTIONAL)
   [gears]                               NAME = ["E1", "E2", ...]: the elements closed in that gear
 
 Checks (each a GearboxError naming the file and the key, no traceback): the TOML, every key known, every
@@ -34,7 +35,12 @@ from pathlib import Path
 
 from ..calibration import Calibration, CalibrationError
 from ..calibration.loader import from_document
+from ..calibration.parameters import OPTIONAL, PARAMETERS
 from ..util.tomlfile import read_toml
+
+
+# a calibration's optional parameters (the open element's drag): an override may add them to a base file without
+_OPTIONAL = {(section, name) for section, name, *_ in PARAMETERS if name in OPTIONAL}
 
 
 class GearboxError(Exception):
@@ -233,7 +239,7 @@ def _calibration(r: _Reader, path: Path, where: str, cal_entry: str, overrides: 
             if not isinstance(entries, dict) or not isinstance(doc.get(section), dict):
                 r.fail(f"{where}overrides.{section}", f"not a section of the calibration file {cal_path.name}")
             for name, entry in entries.items():
-                if name not in doc[section]:
+                if name not in doc[section] and (section, name) not in _OPTIONAL:
                     r.fail(f"{where}overrides.{section}.{name}", f"not a parameter of {cal_path.name}")
                 doc[section][name] = entry
                 replaced.append(f"{section}.{name}")

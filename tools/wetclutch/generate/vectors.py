@@ -74,6 +74,30 @@ def edges_profile(cal: Calibration):
             "theta_housing_degC": np.full(n, 40.0), "torque_request_Nm": request, "mode": mode}
 
 
+# The open element's drag (DESIGN 15) runs table1 with an 8-speed element's open drag: the retracted piston's
+# 1.5 mm stroke over table1's 8 gaps and the open pack's aeration at 1500 rpm (tools/gearboxes/8hp.toml); the C
+# test sets the same two fields on its copy of wc_table1_calibration.
+OPEN_CLEARANCE_M = 1.875e-4
+OPEN_AERATION_SPEED_RAD_S = 157.08
+OPEN_SLIPS_RPM = (50.0, 150.0, 400.0, 1000.0, 1500.0, 2500.0, 4000.0, -1500.0, -300.0, 20.0)   # 60 ms each
+
+
+def open_drag_profile(cal: Calibration):
+    """The open element's drag (DESIGN 15) in 1 s: open (the piston at the solenoid's minimum, below its return
+    spring) at each slip of OPEN_SLIPS_RPM for 60 ms; torque control (80 Nm at 750 rpm) from 0.6 s: the piston
+    passes its spring, the clearance goes; open again from 0.8 s: the pressure falls below the spring, the
+    clearance returns. Oil and housing at 60 degC, the estimate starting there."""
+    n = int(round(1.0 / cal.period))
+    k = np.arange(n)
+    t = k * cal.period
+    level = np.minimum((t / 0.06 + 1e-9).astype(int), len(OPEN_SLIPS_RPM) - 1)
+    slip = np.where(t < 0.6, np.asarray(OPEN_SLIPS_RPM)[level], 750.0)
+    torque = (t >= 0.6) & (t < 0.8)
+    return {"step": k.astype(float), "slip_rpm": slip, "theta_oil_degC": np.full(n, 60.0),
+            "theta_housing_degC": np.full(n, 60.0), "torque_request_Nm": np.where(torque, 80.0, 0.0),
+            "mode": np.where(torque, model.MODE_TORQUE, model.MODE_OPEN)}
+
+
 def _c_double(x: float) -> str:
     return f"{x:.9g}" if math.isfinite(x) else "NAN"
 
@@ -120,6 +144,14 @@ def header_text(cal: Calibration, command: str) -> str:
     eout = model.clutch_steps(edges_cal, ein["slip_rpm"], ein["theta_oil_degC"], ein["theta_housing_degC"],
                               ein["torque_request_Nm"], mode=ein["mode"], theta_start_degC=40.0)
     edges = {**ein, **eout, "hbar_um": eout["hbar_m"] * 1e6}
+    open_cal = cal.with_values(open_clearance=OPEN_CLEARANCE_M, open_aeration_speed=OPEN_AERATION_SPEED_RAD_S)
+    oin = open_drag_profile(open_cal)
+    oout = model.clutch_steps(open_cal, oin["slip_rpm"], oin["theta_oil_degC"], oin["theta_housing_degC"],
+                              oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
+    film = model.clutch_steps(cal, oin["slip_rpm"], oin["theta_oil_degC"], oin["theta_housing_degC"],
+                              oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
+    drag = {**oin, **oout, "open": (oout["pressure_model_Pa"] * cal.piston_area - cal.return_spring_force <= 0.0)
+            .astype(float), "film_torque_Nm": film["torque_Nm"], "film_theta_degC": film["theta_degC"]}
     return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
@@ -134,7 +166,9 @@ def header_text(cal: Calibration, command: str) -> str:
         "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, theta_degC; int status; }"
         " wc_golden_hot_clutch_t;\n"
         "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, torque_Nm, hbar_um, contact_force_N,"
-        " static_capacity_Nm; int status; } wc_golden_edges_t;\n\n"
+        " static_capacity_Nm; int status; } wc_golden_edges_t;\n"
+        "typedef struct { double step, slip_rpm, torque_request_Nm, mode, open, pressure_model_Pa, torque_Nm,"
+        " theta_degC, film_torque_Nm, film_theta_degC; } wc_golden_open_drag_t;\n\n"
         + _table("wc_golden_torque", "wc_golden_torque_t", {**tin, **tout},
                  ("slip_rpm", "theta_degC", "force_N", "torque_Nm", "coulomb_Nm", "viscous_Nm", "hbar_um", "mu_f"))
         + "\n" + _table("wc_golden_inverse", "wc_golden_inverse_t", {**iin, **iout},
@@ -152,6 +186,13 @@ def header_text(cal: Calibration, command: str) -> str:
         + _table("wc_golden_edges", "wc_golden_edges_t", edges,
                  ("step", "slip_rpm", "torque_request_Nm", "current_mA", "torque_Nm", "hbar_um", "contact_force_N",
                   "static_capacity_Nm", "status"))
+        + f"\n/* wc_clutch_step on the open element's series (vectors.open_drag_profile), table1 with\n"
+        f" * open_clearance_m = {OPEN_CLEARANCE_M} and open_aeration_speed_rad_s = {OPEN_AERATION_SPEED_RAD_S} (DESIGN 15);"
+        " open: the\n * modelled piston below its spring; film_*: the same series with both 0 (the film alone). Every"
+        " step. */\n"
+        + _table("wc_golden_open_drag", "wc_golden_open_drag_t", drag,
+                 ("step", "slip_rpm", "torque_request_Nm", "mode", "open", "pressure_model_Pa", "torque_Nm",
+                  "theta_degC", "film_torque_Nm", "film_theta_degC"))
         + adapt_vectors.header_part(cal)
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )

@@ -24,6 +24,8 @@ element's and every other quantity is the element's:
   film_squeeze_factor / a^4 the squeeze film's Reynolds factor K (wc_model.c) is homogeneous of degree 4 in the
                             radii: phi K stays the element's (0 here: the description's base, table1, has the
                             film state off)
+  open_aeration_speed / |a| the open drag's factor 1 / (1 + (slip / w_a)^2) (DESIGN 15) takes the element's slip,
+                            a |a| x the controller's; the open clearance (a gap) is the element's
 So the equivalent clutch's torque, capacity, film and heat are the element's, exact in real arithmetic; in
 float32 the radii, R_eff and K round once more (relative 1e-7). NOT scaled, on purpose: the lock and breakaway
 bands (lock_slip 0.3, breakaway_slip 0.8 rad/s: "6 sigma of a 0.5 rpm speed sensor") are detection bands of
@@ -97,8 +99,8 @@ def _element_clutch_values(gearbox_path: str, element: str) -> dict:
 
 def equivalent_clutch_values(gearbox_path, element: str, slip_scale: float, scale_bands: bool = False) -> dict:
     """The image's clutch fields of the element's EQUIVALENT clutch in the controller's coordinates (module
-    docstring): radii x |a|, film_squeeze_factor / a^4, everything else (the heat capacity included) the
-    element's own; the lock and breakaway bands / |a| only with scale_bands (they are the measured slip's
+    docstring): radii x |a|, film_squeeze_factor / a^4, the open drag's aeration speed / |a| (a slip; 0 stays
+    off), everything else (the heat capacity and the open clearance included) the element's own; the lock and breakaway bands / |a| only with scale_bands (they are the measured slip's
     bands, not the plates'). Raises ShiftError when a scaled value leaves the firmware's limits (wc_replay
     checks the image again)."""
     s = abs(float(slip_scale))
@@ -110,6 +112,7 @@ def equivalent_clutch_values(gearbox_path, element: str, slip_scale: float, scal
     if scale_bands:
         for name in ("clutch.lock_slip_rad_s", "clutch.breakaway_slip_rad_s"):
             values[name] = f32(values[name] / s)
+    values["clutch.open_aeration_speed_rad_s"] = f32(values["clutch.open_aeration_speed_rad_s"] / s)
     phi = values["clutch.film_squeeze_factor"]
     if phi > 0.0:
         values["clutch.film_squeeze_factor"] = f32(phi / s ** 4)

@@ -33,7 +33,8 @@ class ClutchReference:
     solenoid's minimum/maximum current) -> current, led ahead of the squeeze film and the VFS lag when
     lag_compensation_time_s > 0 (DESIGN 9: lead_film, lead_lag); VFS lag (exact, tau) -> reached pressure ->
     apply force F = max(P A_p - F_s, 0) -> contact force (F, or with the squeeze-film state on, the asperity
-    force at the film state, which then advances under F: film_advance_m) -> model torque; lock-up (Lockup)
+    force at the film state, which then advances under F: film_advance_m) -> model torque (the piston below its
+    spring, P A_p - F_s <= 0 and no bench force: the open element's drag, friction.open_gap_m, DESIGN 15); lock-up (Lockup)
     against the static capacity with the required torque (the measured torque on a bench, else
     carried_torque_Nm when given, else the request, in the lock direction); while locked the held torque
     (Lockup.torque_Nm), no heat and STATUS_LOCKED; observer advanced with |T dw| and kept in
@@ -124,15 +125,20 @@ class ClutchReference:
             force = bench_force_N
         # inside the lock band the torque keeps the lock direction (the slip's sign there is noise)
         in_band = abs(slip_rpm) * RAD_S_PER_RPM < cal.lock_slip
+        # DESIGN 15: the open element (the modelled piston below its return spring, before the kiss offset; on a
+        # bench no load on the cell) drags through its clearance, aerated
+        open_element = not (pressure * cal.piston_area - cal.return_spring_force > 0.0 if math.isnan(bench_force_N)
+                            else bench_force_N > 0.0)
         if self.film_on:
             contact = cal.friction_area * float(film_contact_pressure_Pa(cal, self.hbar)[0])
             parts = torque_parts(cal, abs(slip_rpm), theta_model, contact, hbar_m=self.hbar,
-                                 friction_factor=corr.friction_factor)
+                                 friction_factor=corr.friction_factor, open_element=open_element)
             self.hbar = film_advance_m(cal, self.hbar, force, theta_model,
                                        squeeze_factor=cal.film_squeeze_factor * corr.film_factor)
         else:
             contact = force
-            parts = torque_parts(cal, abs(slip_rpm), theta_model, force, friction_factor=corr.friction_factor)
+            parts = torque_parts(cal, abs(slip_rpm), theta_model, force, friction_factor=corr.friction_factor,
+                                 open_element=open_element)
         sign = lockup.direction if in_band else (-1.0 if slip_rpm < 0.0 else 1.0)
         torque = float(parts["torque_Nm"]) * sign
         coulomb = abs(float(parts["coulomb_Nm"])) * sign

@@ -44,12 +44,24 @@ def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
             * cal.effective_radius * cal.friction_pairs * np.asarray(contact_force_N, dtype=float))
 
 
-def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, friction_factor: float = 1.0):
+def open_gap_m(cal: Calibration, hbar_m, slip_rpm):
+    """The open element's viscous gap (DESIGN 15; wc_clutch_step): the film plus the retracted piston's clearance
+    per gap, times the open pack's aeration factor, (h_bar + open_clearance) (1 + (slip / w_a)^2), w_a =
+    open_aeration_speed (0: no aeration factor). Both 0: h_bar itself."""
+    gap = np.asarray(hbar_m, dtype=float) + cal.open_clearance
+    if cal.open_aeration_speed > 0.0:
+        gap = gap * (1.0 + (np.asarray(slip_rpm, dtype=float) * RAD_S_PER_RPM / cal.open_aeration_speed) ** 2)
+    return gap
+
+
+def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, friction_factor: float = 1.0,
+                 open_element: bool = False):
     """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
 
     hbar_m: the film the contact force stands on; default the steady film of eq. 16 (the squeeze-film
     state of DESIGN 9 passes its own). friction_factor: the adaptation's scale of mu_f (DESIGN 12; the
-    returned mu_f carries it).
+    returned mu_f carries it). open_element: the piston retracted (DESIGN 15): the viscous term shears
+    open_gap_m instead of the film (the returned h_bar stays the film's).
 
     Torques carry the sign of the slip speed (slip >= 0 counts as positive):
     the torque transmitted through the slipping clutch, which acts against
@@ -66,7 +78,8 @@ def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, f
             if hbar_m is None else np.asarray(hbar_m, dtype=float))
     rn = cal.effective_radius * cal.friction_pairs
     coulomb = rn * mu_f * force                                          # eq. 6
-    viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / hbar  # eq. 7
+    gap = open_gap_m(cal, hbar, slip) if open_element else hbar           # DESIGN 15: the open element's drag
+    viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / gap   # eq. 7
     return {
         "torque_Nm": sign * (coulomb + viscous),                         # eq. 5, 8
         "coulomb_Nm": sign * coulomb,
