@@ -36,6 +36,7 @@ from ..shift.matrix8 import CONTROLLER, END_RATIO_TOLERANCE, LOCKUP_MA, RPM, _pl
 from ..shift.quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
 from ..calibration import shift as shift_calibration
 from ..shift.scenarios import SHIFT_TOML, ShiftError
+from ..shift import transmission8
 from ..shift.transmission8 import ELEMENTS, LIMITS_JERK, TARGET_S, TYPES, AdaptValues, Transmission
 from ..simulate.gearbox_plant import Plant8
 from .driver import Driver, DriverParams
@@ -196,8 +197,8 @@ def shift_missed(q: dict) -> list[str]:
     return m
 
 
-# wc_shift_phase_t (include/wetclutch/wc_shift.h); IDLE inside a shift's window: the 0.2 s after its end
-PHASES = {0: "after", 1: "prepare", 2: "torque", 3: "inertia", 4: "lockup", 5: "locked", 6: "aborted"}
+# wc_shift_phase_t's names (transmission8.PHASES); IDLE inside a shift's window: the 0.2 s after its end
+PHASES = {0: "after", **{k: name for k, name in enumerate(transmission8.PHASES) if k > 0}}
 
 CHANNELS = ("t_s", "target_kmh", "speed_kmh", "pedal", "brake_Nm", "gear", "phase", "engine_rpm", "turbine_rpm",
             "output_rpm", "lockup_mA", "safe") + tuple(f"{e}_{c}" for e in ELEMENTS
