@@ -37,7 +37,10 @@ from ..shift.quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
 from ..calibration import shift as shift_calibration
 from ..shift.scenarios import SHIFT_TOML, ShiftError
 from ..shift import transmission8
-from ..shift.transmission8 import ELEMENTS, LIMITS_JERK, TARGET_S, TYPES, AdaptValues, Transmission
+# issue 29's limits, which issue 31 applies to every shift of the cycle
+from ..shift.transmission8 import (ELEMENTS, EXCURSION_RPM as FLARE_RPM, INERTIA_TOLERANCE as DURATION_TOLERANCE,
+                                   LIMITS_JERK, TARGET_S, THETA_K, TIE_UP_FRACTION, TYPES, AdaptValues, Transmission,
+                                   excursion_rpm, tie_up_fraction, tie_up_Nm)
 from ..simulate.gearbox_plant import Plant8
 from .driver import Driver, DriverParams
 from .schedule import DEFAULT_SCHEDULE, load_schedule
@@ -52,10 +55,6 @@ SHIFT_BEFORE_S, SHIFT_AFTER_S = 0.1, 0.3    # a shift's window about its request
 SHIFT_TIMEOUT_S = 5.0              # a shift that has not ended by then is recorded as hung
 GRAVITY = 9.81
 AIR_DENSITY = 1.2
-# issue 29's limits, which issue 31 applies to every shift of the cycle
-FLARE_RPM, TIE_UP_FRACTION, THETA_K, DURATION_TOLERANCE = 30.0, 0.10, 5.0, 0.10
-TIE_UP_TORQUE_MIN_NM = 20.0        # the fraction's denominator: |T_t| at the request, at least this (a coast's
-#                                    turbine torque is near 0: a fraction of nothing says nothing)
 
 
 @dataclass
@@ -142,19 +141,9 @@ def shift_quality(w: _ShiftWindow, gearbox, ratios: dict) -> dict:
     for ph in np.unique(a["phase"][sl]):
         mask = a["phase"][sl] == ph
         per_phase[PHASES.get(int(ph), str(int(ph)))] = float(np.max(np.abs(jerk[sl][mask]), initial=0.0))
-    r_src, r_tgt = ratios[src], ratios[tgt]
-    w_t, w_o = a["w_t_rpm"][sl], a["w_o_rpm"][sl]
-    hi, lo = max(r_src, r_tgt) * w_o, min(r_src, r_tgt) * w_o
-    flare = float(np.max(np.maximum(np.maximum(w_t - hi, lo - w_t), 0.0), initial=0.0))
-    # tie-up as matrix8's split: the off-going element's torque against the direction it carried at the request
-    # while its piston is on the pack (applied: the controller's doing), apart from its open drag after it left
-    tie_up = drag = 0.0
-    if off is not None:
-        sign = -1.0 if a[f"{off}_torque"][k0] < 0.0 else 1.0
-        fight = np.maximum(-sign * a[f"{off}_torque"][sl], 0.0)
-        applied = a[f"{off}_fill"][sl] >= 1.0
-        tie_up = float(np.max(fight[applied], initial=0.0))
-        drag = float(np.max(fight[~applied], initial=0.0))
+    flare = excursion_rpm(a["w_t_rpm"][sl], a["w_o_rpm"][sl], ratios[src], ratios[tgt])
+    tie_up, drag = tie_up_Nm(a[f"{off}_torque"][sl], a[f"{off}_fill"][sl], float(a[f"{off}_torque"][k0])) \
+        if off is not None else (0.0, 0.0)
     energy = {e: float(a[f"{e}_energy"][min(k1, len(w.rows) - 1)] - a[f"{e}_energy"][k0]) * 1e-3 for e in ELEMENTS}
     theta = {}
     if on is not None:
@@ -167,7 +156,7 @@ def shift_quality(w: _ShiftWindow, gearbox, ratios: dict) -> dict:
          "inertia_time_s": float(report[0]) if report else math.nan, "target_s": TARGET_S[w.kind],
          "peak_jerk_m_s3": max(per_phase.values(), default=0.0), "jerk_per_phase_m_s3": per_phase,
          "flare_rpm": flare, "tie_up_Nm": tie_up, "offgoing_drag_Nm": drag,
-         "tie_up_fraction": tie_up / max(abs(w.torque_Nm), TIE_UP_TORQUE_MIN_NM),
+         "tie_up_fraction": tie_up_fraction(tie_up, w.torque_Nm),
          "energy_kJ": energy, "theta_oncoming_degC": theta}
     q["missed"] = shift_missed(q)
     return q

@@ -27,8 +27,9 @@ low-passed at JERK_CUTOFF_HZ, then its rate) from the request to 0.2 s after the
 higher, sag below the lower), rpm; the inertia time (the controller's report) against the commanded target;
 the time from the request to the turbine at the new gear's speed (within END_RATIO_TOLERANCE, new_speed_s: a
 kickdown's at full load within KICKDOWN_NEW_SPEED_S);
-per element its friction energy; the on-coming element's peak temperature, estimate and truth. Tie-up is not
-measured here yet.
+the tie-up (tie_up_Nm: the off-going element fighting the direction it carried while its piston is applied)
+against the gearbox input torque at the request (at least TIE_UP_TORQUE_MIN_NM); per element its friction
+energy; the on-coming element's peak temperature, estimate and truth.
 
 trace_shift: the same run with its per-period traces (ShiftTrace: the plant's truth, the TCU's outputs); --plots
 (on with --matrix): one Fig. 4-style figure per shift type from them (transmission8_plots, PLOT_CASES).
@@ -250,11 +251,11 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
             break
     truth = plant.record()
     on = ELEMENTS[on_index]
-    quality = _quality(plant, truth, theta_estimate, report, end_k, n_pre, (src, tgt, on), (ratio_src, ratio_tgt),
-                       kind_seen, {"vehicle": str(vehicle), "kind": kind, "load": load, "oil_degC": oil_degC,
-                                   "pedal": pedal})
-    tcu = dict(zip(TCU_CHANNELS, np.array(tcu_rows, dtype=float).T)) if tcu_rows else {}
     off = next(iter(set(params.gearbox.gears[src]) - set(params.gearbox.gears[tgt])))
+    quality = _quality(plant, truth, theta_estimate, report, end_k, n_pre, (src, tgt, on, off),
+                       (ratio_src, ratio_tgt), kind_seen, {"vehicle": str(vehicle), "kind": kind, "load": load,
+                                                           "oil_degC": oil_degC, "pedal": pedal})
+    tcu = dict(zip(TCU_CHANNELS, np.array(tcu_rows, dtype=float).T)) if tcu_rows else {}
     return ShiftTrace(quality, truth, tcu, n_pre, end_k, (ratio_src, ratio_tgt), on, off)
 
 
@@ -263,15 +264,38 @@ def _oncoming_index(params, src: str, tgt: str) -> int:
     return ELEMENTS.index(next(iter(closes)))
 
 
+def excursion_rpm(w_t_rpm, w_o_rpm, ratio_src: float, ratio_tgt: float) -> float:
+    """The turbine's largest excursion outside the band between the two gears' speeds (flare above the higher,
+    sag below the lower), rpm; 0 inside it."""
+    hi, lo = max(ratio_src, ratio_tgt) * w_o_rpm, min(ratio_src, ratio_tgt) * w_o_rpm
+    return float(np.max(np.maximum(np.maximum(w_t_rpm - hi, lo - w_t_rpm), 0.0), initial=0.0))
+
+
+def tie_up_Nm(offgoing_torque_Nm, offgoing_fill, torque_at_request_Nm: float) -> tuple[float, float]:
+    """(tie-up, open drag), N m: the off-going element's torque against the direction it carried at the request
+    (torque_at_request_Nm, its sign), while its piston is on the pack (fill >= 1: the controller's doing) and
+    after it left (its open drag, not the controller's); as matrix8 splits them."""
+    sign = -1.0 if torque_at_request_Nm < 0.0 else 1.0
+    fight = np.maximum(-sign * np.asarray(offgoing_torque_Nm, dtype=float), 0.0)
+    applied = np.asarray(offgoing_fill, dtype=float) >= 1.0
+    return float(np.max(fight[applied], initial=0.0)), float(np.max(fight[~applied], initial=0.0))
+
+
+def tie_up_fraction(tie_up: float, turbine_torque_Nm: float) -> float:
+    """The tie-up against the turbine torque at the request (at least TIE_UP_TORQUE_MIN_NM)."""
+    return tie_up / max(abs(turbine_torque_Nm), TIE_UP_TORQUE_MIN_NM)
+
+
 def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, kind_seen, case):
     dt = plant.dt
-    src, tgt, on = gears
+    src, tgt, on, off = gears
     ratio_src, ratio_tgt = ratios
     k1 = (end_k if end_k is not None else len(theta_estimate) - 1) + int(round(0.2 / dt))
     sl = slice(n_pre + 1, min(k1 + 1, truth["t_s"].size))
-    w_t, w_o = truth["turbine_speed_rpm"][sl], truth["output_speed_rpm"][sl]
-    hi, lo = max(ratio_src, ratio_tgt) * w_o, min(ratio_src, ratio_tgt) * w_o
-    excursion = float(np.max(np.maximum(np.maximum(w_t - hi, lo - w_t), 0.0), initial=0.0))
+    excursion = excursion_rpm(truth["turbine_speed_rpm"][sl], truth["output_speed_rpm"][sl], ratio_src, ratio_tgt)
+    t_t = float(truth["input_torque_Nm"][n_pre])       # the gearbox input torque at the request (the truth's)
+    tie_up, drag = tie_up_Nm(truth[f"{off}_torque_Nm"][sl], truth[f"{off}_fill"][sl],
+                             float(truth[f"{off}_torque_Nm"][n_pre]))
     st_end = {key: arr[-1] for key, arr in truth.items()}
     # the 1->2 runs' and the power-on matrix's measure (quality.py): the acceleration low-passed, then its rate
     jerk = np.gradient(_lowpass_zero_phase(truth["vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ), dt)
@@ -289,7 +313,8 @@ def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, 
             "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
             "inertia_time_s": inertia, "target_s": TARGET_S[case["kind"]], "new_speed_s": new_speed_s,
             "peak_jerk_m_s3": float(np.max(np.abs(jerk[sl]), initial=0.0)),
-            "excursion_rpm": excursion, "energy_kJ": energy, "oncoming": on,
+            "excursion_rpm": excursion, "turbine_torque_Nm": t_t, "tie_up_Nm": tie_up, "offgoing_drag_Nm": drag,
+            "tie_up_fraction": tie_up_fraction(tie_up, t_t), "energy_kJ": energy, "oncoming": on, "offgoing": off,
             "peak_theta_estimate_degC": theta_est,
             "peak_theta_truth_degC": float(np.max(truth[f"{on}_theta_degC"][sl]))}
 
@@ -302,6 +327,9 @@ CASES = ((2, 3, "power-on upshift"), (2, 3, "power-off upshift"), (3, 2, "power-
 LIMITS_JERK = {"power-on upshift": 10.0, "power-off upshift": 5.0, "power-on downshift": 15.0,
                "power-off downshift": 5.0}      # issue 29: peak output jerk by type, m/s^3
 EXCURSION_RPM, THETA_K, INERTIA_TOLERANCE = 30.0, 5.0, 0.10
+TIE_UP_FRACTION = 0.10           # issue 29: the off-going element's fight, of the turbine torque at the request
+TIE_UP_TORQUE_MIN_NM = 20.0      # the fraction's denominator at least this: a coast's turbine torque is near 0, and
+#                                  a fraction of nothing says nothing
 KICKDOWN_NEW_SPEED_S = 0.6       # issue 29: a kickdown's turbine at the new gear's speed within 0.6 s at full load
 SKIP_DOWNS = ((8, 6), (7, 5), (6, 4), (5, 3), (4, 2), (3, 1))   # DESIGN 15's single-element skips
 # the plots per type (transmission8_plots): the first case of each type in CASES (2->3 up, 3->2 down)
@@ -334,6 +362,8 @@ def missed(q: dict) -> list[str]:
         m.append(f"jerk {q['peak_jerk_m_s3']:.1f} > {LIMITS_JERK[kind]:g}")
     if q["excursion_rpm"] > EXCURSION_RPM:
         m.append(f"flare/sag {q['excursion_rpm']:.0f} rpm")
+    if q["tie_up_fraction"] > TIE_UP_FRACTION:
+        m.append(f"tie-up {100 * q['tie_up_fraction']:.0f} %")
     stretched = kind == "power-on downshift"       # the engine torque sets a kickdown's pace (wc_shift.h)
     if math.isfinite(q["inertia_time_s"]) and (q["inertia_time_s"] < (1 - INERTIA_TOLERANCE) * q["target_s"] or (
             not stretched and q["inertia_time_s"] > (1 + INERTIA_TOLERANCE) * q["target_s"])):
