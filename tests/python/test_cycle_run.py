@@ -33,7 +33,7 @@ def test_the_low_phase_runs_through_and_reports(low):
     rc, out, figures, shifts = low
     assert rc == (1 if figures["missed"] else 0)          # exit 1 exactly when a target is missed
     for name in ("nominal_low.md", "nominal_low.mf4", "nominal_low/speed.png", "nominal_low/temperatures.png",
-                 "nominal_low/jerk.png"):
+                 "nominal_low/jerk.png", "nominal_low/learned.png"):
         assert (out / name).stat().st_size > 0, name
     assert figures["duration_s"] == pytest.approx(589.0, abs=0.02)
     # the low phase's trace asks for a few dozen shifts of both directions; every one is reported
@@ -140,7 +140,7 @@ def _fake(shifts, scales):
     values = {e: {"friction_scale": list(scales), "confidence": [0.5] * 5, "film_factor": 1.0, "kiss_offset_Pa": 0.0,
                   "shifts_learned": 3} for e in runner.ELEMENTS}
     qs = [{"t_s": t, "shift": s, "peak_jerk_m_s3": j, "missed": []} for t, s, j in shifts]
-    return runner.CycleResult("fake", None, {}, qs, [], [], 0.0, 0, True, values)
+    return runner.CycleResult("nominal", None, {}, qs, [], [], 0.0, 0, True, values)
 
 
 def test_the_adaptation_targets_are_judged():
@@ -159,6 +159,22 @@ def test_the_adaptation_targets_are_judged():
     outside = [good[0], good[1], _fake([], [1.35] * 5)]
     assert any("outside their bands" in m for m in adaptation_figures(ref, outside)["missed"])
     assert any("3 needed" in m for m in adaptation_figures(ref, good[:2])["missed"])
+
+
+def test_the_learned_values_truth_is_the_plants_lining_against_the_model():
+    """What each element should learn (report.learned_truth, the report's learned values against truth): the
+    friction scale at the nodes is the plant file's lining factor times the true material's friction against
+    the model's (eq. 18's ratio); so the SUV's over the nominal's is its [truth.friction_scale] factor exactly
+    (both plants share the material), read here from the file itself."""
+    import tomllib
+    from wetclutch.cycle.report import learned_truth
+    suv, nominal = learned_truth(str(UNSEEN / "plant.toml")), learned_truth("nominal")
+    factors = tomllib.loads((UNSEEN / "plant.toml").read_text())["truth"]["friction_scale"]
+    for e in runner.ELEMENTS:
+        assert suv[e]["theta_nodes_degC"] == nominal[e]["theta_nodes_degC"]
+        for a, b in zip(suv[e]["friction_scale"], nominal[e]["friction_scale"]):
+            assert a / b == pytest.approx(factors[e]["value"], rel=1e-9), e     # float64 ratio: rounding only
+        assert suv[e]["kiss_offset_Pa"] == nominal[e]["kiss_offset_Pa"] == 0.0   # the elements' own springs
 
 
 def test_a_bad_adaptation_count_is_an_input_error(tmp_path, capsys):

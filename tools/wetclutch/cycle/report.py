@@ -66,7 +66,61 @@ def evaluate(result) -> dict:
             "adaptation": ("on: power-on upshifts learn into their on-coming element; learned shifts per element "
                            + ", ".join(f"{e} {v['shifts_learned']}" for e, v in result.learned.items()))
             if result.adaptation else "off (wetclutch cycle --adaptation N runs N cycles with it)",
+            "learned": evaluate_learned(result),
             "missed": missed}
+
+
+def learned_truth(vehicle) -> dict:
+    """Per element what its adaptation should learn on this vehicle (DESIGN 12; the adaptation study's
+    simulate.plant.variants.VariantTruth): the friction scale at the shift calibration's temperature nodes (the
+    plant's true clutch and friction scale against the element's own calibration in the gearbox description, eq.
+    18's ratio at the inertia phase's slip), the film factor and the kiss-point offset."""
+    from ..shift.adaptation_study import bands
+    from ..shift.matrix8 import CONTROLLER, _plant_and_models, plant_path
+    from ..shift.scenarios import SHIFT_TOML
+    from ..calibration import shift as shift_calibration
+    from ..simulate.plant.variants import VariantTruth
+    params, _ = _plant_and_models(str(plant_path(vehicle)))
+    gb = params.gearbox
+    nodes = bands(shift_calibration.load(SHIFT_TOML).variants[CONTROLLER])["theta_nodes_degC"]
+    out = {}
+    for e in ELEMENTS:
+        plant_cal, tcu_cal = params.truth[e], gb.element(e).calibration
+        truth = VariantTruth(plant_cal=plant_cal, tcu_cal=tcu_cal, friction_scale_plant=params.friction_scale[e],
+                             # NaN where the element's model has no squeeze film (factor 0): nothing to learn
+                             film_factor=plant_cal.film_squeeze_factor / tcu_cal.film_squeeze_factor
+                             if tcu_cal.film_squeeze_factor > 0.0 else math.nan,
+                             kiss_offset_Pa=plant_cal.return_spring_force / plant_cal.piston_area
+                             - tcu_cal.return_spring_force / tcu_cal.piston_area)
+        out[e] = truth.as_dict(nodes)
+    return out
+
+
+def plot_learned(path: Path, learned: list, truth: dict, labels: list) -> str:
+    """One panel per element: the learned friction scale at each node (one series per entry of ``learned``, e.g.
+    per cycle) against the truth, the nodes without confidence hollow; the film factor and kiss offset, learned
+    (the last) against the truth, in the panel's title."""
+    from ..util import plotting
+    fig, ax = plotting.subplots(1, len(ELEMENTS), figsize=(16, 4), sharey=True)
+    for a, e in zip(ax, ELEMENTS):
+        tr = truth[e]
+        nodes = tr["theta_nodes_degC"]
+        a.plot(nodes, tr["friction_scale"], "k-", lw=1.5, label="truth")
+        for i, (values, label) in enumerate(zip(learned, labels)):
+            v = values[e]
+            conf = np.asarray(v["confidence"]) > 0.0
+            sc = np.asarray(v["friction_scale"])
+            a.plot(nodes, sc, "-", color=f"C{i}", lw=0.8, label=f"{label} ({v['shifts_learned']} shifts)")
+            a.plot(np.asarray(nodes)[conf], sc[conf], "o", color=f"C{i}")
+            a.plot(np.asarray(nodes)[~conf], sc[~conf], "o", color=f"C{i}", mfc="none")
+        last = learned[-1][e]
+        a.set_title(f"{e}: film {last['film_factor']:.2f} (truth {tr['film_factor']:.2f})\n"
+                    f"kiss {last['kiss_offset_Pa'] / 1e3:+.0f} kPa (truth {tr['kiss_offset_Pa'] / 1e3:+.0f})", fontsize=9)
+        a.set_xlabel("surface temperature node, degC")
+        a.grid(True, alpha=0.3)
+    ax[0].set_ylabel("friction scale")
+    ax[-1].legend(fontsize=7)
+    return plotting.save(fig, path)
 
 
 def markdown(figures: dict, shifts: list) -> str:
@@ -81,6 +135,11 @@ def markdown(figures: dict, shifts: list) -> str:
              "- observer, max |estimate - truth| per element: " + ", ".join(
                  f"{e} {k:.1f} K" for e, k in f["observer_max_error_K"].items()),
              f"- adaptation: {f['adaptation']}",
+             "- learned friction scale at the nodes " + ", ".join(f"{t:g}" for t in next(iter(
+                 f["learned"].values()))["truth"]["theta_nodes_degC"]) + " degC, learned / truth: " + "; ".join(
+                 f"{e} " + " ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(
+                     (v["learned"] or {}).get("friction_scale", [math.nan] * len(v["truth"]["friction_scale"])),
+                     v["truth"]["friction_scale"])) for e, v in f["learned"].items()),
              f"- **missed: {'; '.join(f['missed']) or 'nothing'}**", "",
              "| type | shifts | every limit met | peak jerk max m/s^3 | flare max rpm | tie-up max % |",
              "|---|---|---|---|---|---|"]
@@ -106,7 +165,8 @@ def markdown(figures: dict, shifts: list) -> str:
 
 def plots(result, shifts: list, out: Path) -> list[Path]:
     """speed.png (trace, driven speed, gear), temperatures.png (each element's estimate and truth),
-    jerk.png (peak jerk per shift by type against the type's limit)."""
+    jerk.png (peak jerk per shift by type against the type's limit), learned.png (each element's learned values at
+    the cycle's end against their truth, plot_learned)."""
     from ..shift.transmission8 import LIMITS_JERK
     from ..util import plotting
     c = result.channels
@@ -138,7 +198,15 @@ def plots(result, shifts: list, out: Path) -> list[Path]:
     ax.set_ylabel("peak jerk m/s^3")
     ax.legend()
     paths.append(plotting.save(fig, out / "jerk.png"))
+    if result.learned:
+        truth = {e: v["truth"] for e, v in evaluate_learned(result).items()}
+        paths.append(plot_learned(out / "learned.png", [result.learned], truth, ["learned"]))
     return paths
+
+
+def evaluate_learned(result) -> dict:
+    """{element: {learned, truth}} of a cycle (evaluate's "learned")."""
+    return {e: {"learned": result.learned.get(e), "truth": t} for e, t in learned_truth(result.vehicle).items()}
 
 
 UNITS = {"t_s": "s", "target_kmh": "km/h", "speed_kmh": "km/h", "pedal": "1", "brake_Nm": "N*m", "gear": "1",
@@ -199,7 +267,7 @@ def adaptation_figures(reference, cycles: list) -> dict:
             worse.append((q["t_s"], q["shift"], same[0]["peak_jerk_m_s3"], q["peak_jerk_m_s3"]))
     if worse:
         missed.append(f"cycle 1: {len(worse)} shift(s) worse than without adaptation by more than 2 %")
-    return {"learned": learned, "worse_in_cycle_1": worse, "missed": missed,
+    return {"learned": learned, "truth": learned_truth(reference.vehicle), "worse_in_cycle_1": worse, "missed": missed,
             "shifts_per_cycle": [len(c.shifts) for c in cycles],
             "meeting_every_limit": [sum(not q["missed"] for q in c.shifts) for c in [reference, *cycles]]}
 
@@ -240,6 +308,8 @@ def command(vehicles, phase: str, oil_degC, out: Path, adaptation_cycles: int = 
             if cycles:
                 a = adaptation_figures(result, cycles)
                 atomic.write_text(out / f"{name}_adaptation.json", json.dumps(a, indent=1, default=float))
+                plot_learned(out / f"{name}_adaptation.png", a["learned"], a["truth"],
+                             [f"cycle {k}" for k in range(1, len(cycles) + 1)])
                 print(f"wetclutch cycle: adaptation over {len(cycles)} cycle(s): every limit met by"
                       f" {a['meeting_every_limit']} shifts (without, then cycle 1, 2, ...); missed:"
                       f" {'; '.join(a['missed']) or 'nothing'}; {out / (name + '_adaptation.json')}")
