@@ -46,8 +46,9 @@ typedef struct {
     float breakaway_slip_rad_s;        /* |slip| above it while locked: breakaway (> lock_slip_rad_s) */
     float holding_margin;              /* a locked clutch is held at (1 + margin) times the request's force */
     uint32_t lock_dwell_periods;       /* control periods inside the lock band before locking */
-    /* The open element's drag (DESIGN 15): with the piston retracted (modelled apply force P A_p - F_s <= 0)
-     * the viscous term shears the retracted stroke's clearance too, and the open pack's aeration lowers it */
+    /* The open element's drag (DESIGN 15): with the piston retracted (modelled P A_p at or below the return
+     * spring's preload, 0.8 F_s; part-way between that and F_s) the viscous term shears the retracted stroke's
+     * clearance too (that part of it), and the open pack's aeration lowers it */
     float open_clearance_m;            /* retracted piston's stroke per gap, x_s / N_c, added to h_bar; 0: off */
     float open_aeration_speed_rad_s;   /* w_a: open drag / (1 + (slip / w_a)^2); 0: off */
     wc_film_table_t film;

@@ -115,19 +115,35 @@ static void lead_film(const wc_model_t *model, float hbar_m, float contact_Pa, f
     (void)wc_vfs_current_mA(cal, kiss_pressure_Pa(cal, force_N, kiss_offset_N), &inv->current_mA);
 }
 
-/* DESIGN 15, the open element's drag: with the piston retracted (open: its modelled apply force 0) the
- * viscous term shears the film h_bar plus the retracted stroke's clearance per gap, and the open pack's
- * aeration divides it by 1 + (slip / w_a)^2. As a gap: (h_bar + clearance) (1 + (slip / w_a)^2), h_bar
- * <= 1 mm, clearance <= 5 mm, the factor in [1, 1.1e6] (the calibration's limits, |slip| <= WC_SLIP_MAX_rad_s):
- * finite, >= h_bar, so the torque stays finite and only falls. Off (both 0) or applied: h_bar, bit for bit. */
-static inline float open_gap_m(const wc_calibration_t *cal, float hbar_m, bool open, float slip_rad_s)
+/* DESIGN 15, the open element's drag: with the piston off the pack the viscous term shears the film h_bar
+ * plus the retracted stroke's clearance per gap, and the open pack's aeration divides it by 1 + (slip / w_a)^2.
+ * The piston strokes against its return spring, whose force rises from its preload at the retracted end
+ * (WC_SPRING_PRELOAD_FRACTION x F_s) to F_s at the pack (the kiss point): with P A_p between the two it stands
+ * in between, retracted by the fraction r = (F_s - P A_p) / ((1 - preload) F_s) in [0, 1] (the spring's rate),
+ * and the gap is (h_bar + r clearance) (1 + r (slip / w_a)^2): at the kiss point the film alone, as the plates
+ * shear it there, fully retracted the clearance and the whole aeration. h_bar <= 1 mm, clearance <= 5 mm, the
+ * factor in [1, 1.1e6] (the calibration's limits, |slip| <= WC_SLIP_MAX_rad_s): finite, >= h_bar, so the torque
+ * stays finite and only falls. Off (both 0) or applied (r = 0): h_bar, bit for bit. */
+#define WC_SPRING_PRELOAD_FRACTION 0.8f
+
+static inline float retracted_fraction(const wc_calibration_t *cal, float pressure_Pa)
+{
+    const float spring_N = cal->return_spring_force_N;
+    const float piston_N = pressure_Pa * cal->piston_area_m2;
+    const float band_N = (1.0f - WC_SPRING_PRELOAD_FRACTION) * spring_N;
+    if (!(band_N > 0.0f)) { return (piston_N > 0.0f) ? 0.0f : 1.0f; }  /* no spring (F_s 0): no band */
+    const float r = (spring_N - piston_N) / band_N;
+    return (r > 0.0f) ? ((r < 1.0f) ? r : 1.0f) : ((r <= 0.0f) ? 0.0f : 1.0f);  /* NaN: retracted */
+}
+
+static inline float open_gap_m(const wc_calibration_t *cal, float hbar_m, float retracted, float slip_rad_s)
 {
     float gap_m = hbar_m;
-    if (open) {
-        gap_m += cal->open_clearance_m;
+    if (retracted > 0.0f) {
+        gap_m += retracted * cal->open_clearance_m;
         if (cal->open_aeration_speed_rad_s > 0.0f) {
             const float aeration = slip_rad_s / cal->open_aeration_speed_rad_s;
-            gap_m *= 1.0f + aeration * aeration;
+            gap_m *= 1.0f + retracted * aeration * aeration;
         }
     }
     return gap_m;
@@ -243,8 +259,11 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     clutch->pressure_model_Pa = wc_vfs_lag_at(model, clutch->pressure_model_Pa, inv.current_mA);
     out->pressure_model_Pa = clutch->pressure_model_Pa;
     float force_N = wc_contact_force_at(model->cal, clutch->pressure_model_Pa);
-    /* DESIGN 15: the piston retracted, its modelled apply force P A_p - F_s (before the learned kiss offset) 0 */
-    bool open = !(force_N > 0.0f);
+    /* DESIGN 15: how far the piston stands off the pack (before the learned kiss offset); without an open
+     * drag calibrated (both fields 0) it changes nothing, and is not computed */
+    const wc_calibration_t *drag_cal = model->cal;
+    float retracted = ((drag_cal->open_clearance_m > 0.0f) || (drag_cal->open_aeration_speed_rad_s > 0.0f))
+                          ? retracted_fraction(drag_cal, clutch->pressure_model_Pa) : 0.0f;
     if (corrected && nonzero(correction.kiss_offset_N)) {
         /* DESIGN 12: the learned kiss point moves the spring's preload: F = P A_p - F_s - offset, within
          * [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */
@@ -260,7 +279,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (in->bench.valid && !bench_torque) { status |= WC_STATUS_TORQUE_INVALID; }
     if (bench_force) {
         force_N = in->bench.apply_force_N;
-        open = !(force_N > 0.0f);  /* a bench's load cell measures the apply force itself */
+        retracted = (force_N > 0.0f) ? 0.0f : 1.0f;  /* a bench's load cell measures the apply force itself */
     }
     /* valid: the modelled force is in [0, F_max] (F_max <= WC_FORCE_MAX_N by the
      * calibration check), the bench force was range-checked above */
@@ -275,7 +294,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         /* DESIGN 9: the asperities carry F_c(h_bar) of the film state; the
          * squeeze film carries the rest, and the film advances under the force. */
         const float contact_N = cal->friction_area_m2 * contact.pressure_Pa;
-        wc_torque_at_gap(&point, signed_slip_rad_s, contact_N, hbar_m, open_gap_m(cal, hbar_m, open, u->slip_rad_s),
+        wc_torque_at_gap(&point, signed_slip_rad_s, contact_N, hbar_m, open_gap_m(cal, hbar_m, retracted, u->slip_rad_s),
                          &out->model);
         out->contact_force_N = contact_N;
         clutch->film_hbar_m = wc_film_advance_at_m(&cal->film, cal->friction_area_m2, hbar_m, &contact, force_N,
@@ -287,7 +306,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
         const float steady_hbar_m =
             wc_film_hbar_near_m(&cal->film, force_N / cal->friction_area_m2, WC_FILM_NO_SEGMENT);
         wc_torque_at_gap(&point, signed_slip_rad_s, force_N, steady_hbar_m,
-                         open_gap_m(cal, steady_hbar_m, open, u->slip_rad_s), &out->model);
+                         open_gap_m(cal, steady_hbar_m, retracted, u->slip_rad_s), &out->model);
         out->contact_force_N = force_N;
     }
 

@@ -443,10 +443,12 @@ static void test_engagement_edges_match_golden(void **state)
  * control, open again; and table1 as it is (both fields 0) on the same series against the reference's
  * film-only columns. Tolerances: torque 1e-3 relative + 1e-3 Nm (float against double, the film table against
  * eq. 9/15 (4e-5) and the VFS lag in float; the open drag is 0.03..1.2 Nm, so the engagement edges' 0.05 Nm
- * would hide a wrong gap); the estimate 0.02 K (the heat of those torque errors over the 1 s); within 2 steps of
- * the reference's piston crossing its spring (open <-> applied) float may decide one step from double: not
- * compared. The model without the open drag gives the film-only column on the open rows: 7 to 67 times the
- * reference's torque (checked below on the vectors, at least 5), so this test fails without it. */
+ * would hide a wrong gap); the estimate 0.02 K (the heat of those torque errors over the 1 s). The piston
+ * stands off the pack by a fraction that is continuous in the pressure across its spring's band (0.8..1 F_s),
+ * so no step is skipped: the rows within the band (the reference's 0 < open < 1, passed on the way up and
+ * down) lie between the open drag and the film alone. The model without the open drag gives the film-only
+ * column on the fully open rows: 7 to 67 times the reference's torque (checked below on the vectors, at
+ * least 5), so this test fails without it. */
 static void test_open_drag_matches_golden(void **state)
 {
     (void)state;
@@ -461,6 +463,7 @@ static void test_open_drag_matches_golden(void **state)
     wc_test_worst_t torque_worst = { 0.0, -1 };
     wc_test_worst_t theta_worst = { 0.0, -1 };
     size_t open_rows = 0u;
+    size_t band_rows = 0u;
     for (size_t k = 0u; k < rows; ++k) {
         const wc_golden_open_drag_t *g = &wc_golden_open_drag[k];
         wc_step_input_t in;
@@ -477,11 +480,6 @@ static void test_open_drag_matches_golden(void **state)
         WC_CHECK_CLOSE("theta_degC", (long)k, out.theta_degC, g->theta_degC, 0.0, 0.02);
         WC_CHECK_CLOSE("film theta_degC", (long)k, film_out.theta_degC, g->film_theta_degC, 0.0, 0.02);
         wc_test_worst_update(&theta_worst, fabs((double)out.theta_degC - g->theta_degC), (long)k);
-        bool near_crossing = false;
-        for (size_t j = (k > 2u) ? k - 2u : 1u; (j <= k + 2u) && (j < rows); ++j) {
-            near_crossing |= (wc_golden_open_drag[j].open > 0.5) != (wc_golden_open_drag[j - 1u].open > 0.5);
-        }
-        if (near_crossing) { continue; }
         WC_CHECK_CLOSE("torque_Nm", (long)k, out.model.torque_Nm, g->torque_Nm, 1e-3, 1e-3);
         WC_CHECK_CLOSE("film torque_Nm", (long)k, film_out.model.torque_Nm, g->film_torque_Nm, 1e-3, 1e-3);
         wc_test_worst_update(&torque_worst, fabs((double)out.model.torque_Nm - g->torque_Nm) /
@@ -492,12 +490,16 @@ static void test_open_drag_matches_golden(void **state)
                          WC_STATUS_OK);
         WC_CHECK(wc_test_same_float(out.model.hbar_m, steady.hbar_m), "step %zu: h_bar %g, not the film's %g", k,
                  (double)out.model.hbar_m, (double)steady.hbar_m);  /* the film's h_bar is reported, not the gap */
-        if (g->open > 0.5) {
+        if (g->open >= 1.0) {
             ++open_rows;
             WC_CHECK(fabs(g->torque_Nm) * 5.0 <= fabs(g->film_torque_Nm), "step %zu: open drag %g, film alone %g", k,
                      g->torque_Nm, g->film_torque_Nm);
             WC_CHECK(fabsf(out.model.torque_Nm) * 5.0f <= fabsf(steady.torque_Nm), "step %zu: open drag %g, film %g",
                      k, (double)out.model.torque_Nm, (double)steady.torque_Nm);
+        } else if (g->open > 0.0) {
+            ++band_rows;  /* within the spring's band: part of the clearance, less drag than the film alone */
+            WC_CHECK(fabsf(out.model.torque_Nm) < fabsf(steady.torque_Nm), "step %zu: in the band %g, film %g", k,
+                     (double)out.model.torque_Nm, (double)steady.torque_Nm);
         } else {
             /* applied: the piston past its spring, the film alone (the clearance closed), bit for bit */
             WC_CHECK(wc_test_same_float(out.model.torque_Nm, steady.torque_Nm), "step %zu: applied %.9g, film %.9g", k,
@@ -506,7 +508,8 @@ static void test_open_drag_matches_golden(void **state)
     }
     wc_test_worst_print("open drag torque (of tol.)", &torque_worst, 1.0);
     wc_test_worst_print("open drag theta_degC", &theta_worst, 0.02);
-    assert_true(open_rows > 800u);
+    assert_true(open_rows > 700u);
+    assert_true(band_rows >= 10u);  /* the band's rows are compared, not only its two ends */
     /* the heat: the film alone overestimates the open pack's temperature (the reference's last row) */
     assert_true(wc_golden_open_drag[rows - 1u].film_theta_degC - wc_golden_open_drag[rows - 1u].theta_degC > 5.0);
 }

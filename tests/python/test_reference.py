@@ -129,7 +129,8 @@ def test_open_drag_is_the_8speed_plants(element):
     open_clearance) (1 + (slip / w_a)^2)) with tools/gearboxes/8hp.toml's open drag is the 8-speed plant's
     viscous drag of an open element (gearbox_plant/element.py, fill 0: the piston's stroke over N_c gaps and the
     aeration speed of the plant files). Same formula in double: 1e-12 relative. Without the open drag the
-    reference's film alone drags 7 to 100 times more."""
+    reference's film alone drags 7 to 100 times more. Within the spring's band the piston stands part-way, on both
+    sides alike."""
     from wetclutch import gearbox
     from wetclutch.simulate.gearbox_plant.element import TrueElement
     gb = gearbox.load(Path(__file__).resolve().parents[2] / "tools" / "gearboxes" / "8hp.toml")
@@ -150,3 +151,30 @@ def test_open_drag_is_the_8speed_plants(element):
         assert np.sign(float(parts["viscous_Nm"])) == np.sign(rpm)
         film = model.torque_parts(ref_cal, rpm, 60.0, 0.0)
         assert 7.0 < float(film["viscous_Nm"]) / float(parts["viscous_Nm"]) < 100.0
+    # between its retracted end and the pack (DESIGN 15: the return spring's band, 0.8..1 F_s): the plant's piston
+    # at a pressure there comes to rest where the spring balances it (fill f = (P / P_kiss - 0.8) / 0.2); the
+    # reference's retracted fraction from the same pressure is 1 - f, and its drag the plant's at that stroke
+    for share in (0.82, 0.9, 0.97):
+        p_Pa = share * cal.return_spring_force / cal.piston_area
+        r = model.retracted_fraction(ref_cal, p_Pa)
+        assert r == pytest.approx((1.0 - share) / (1.0 - model.friction.SPRING_PRELOAD_FRACTION), rel=1e-12)
+        # the nominal vehicle's feed (3.5e-3 fill volumes per s and Pa, 34 per s): the stroke's time constant
+        # 1 / (g 0.2 P_kiss), about 12 ms
+        band = TrueElement(element, ref_cal, friction_scale=1.0, oil_degC=60.0, housing_degC=60.0,
+                           fill_rate_gain=3.5e-3, fill_rate_max=34.0, stroke_m=stroke_m, aeration_speed=aeration,
+                           dt_s=1e-3, substeps=4)
+        band.set_steady(p_Pa / cal.vfs_gain, 60.0)           # the VFS at the pressure, the piston at either end
+        for _ in range(300):                                   # 0.3 s: 25 time constants
+            band.step_begin(p_Pa / cal.vfs_gain)
+            for j in range(4):
+                band.substep(j)
+            band.step_end(0.0, 1e-3)
+        assert band.fill == pytest.approx(1.0 - r, abs=1e-6)   # the plant's settled stroke: 1 - r
+        for rpm in (150.0, 1500.0):
+            w = rpm * model.RAD_S_PER_RPM
+            plant = band.visc_c * w / (1.0 + band.aer_q * w * w)
+            parts = model.torque_parts(ref_cal, rpm, 60.0, 0.0, open_element=r)
+            # the same formula at the settled stroke (1e-6): double rounding and the stroke's last 1e-6
+            assert float(parts["viscous_Nm"]) == pytest.approx(plant, rel=1e-5)
+    assert model.retracted_fraction(ref_cal, 2.0 * cal.return_spring_force / cal.piston_area) == 0.0
+    assert model.retracted_fraction(ref_cal, 0.0) == 1.0 and model.retracted_fraction(ref_cal, float("nan")) == 1.0

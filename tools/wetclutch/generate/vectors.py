@@ -150,8 +150,8 @@ def header_text(cal: Calibration, command: str) -> str:
                               oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
     film = model.clutch_steps(cal, oin["slip_rpm"], oin["theta_oil_degC"], oin["theta_housing_degC"],
                               oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
-    drag = {**oin, **oout, "open": (oout["pressure_model_Pa"] * cal.piston_area - cal.return_spring_force <= 0.0)
-            .astype(float), "film_torque_Nm": film["torque_Nm"], "film_theta_degC": film["theta_degC"]}
+    drag = {**oin, **oout, "open": np.array([model.retracted_fraction(cal, p) for p in oout["pressure_model_Pa"]]),
+            "film_torque_Nm": film["torque_Nm"], "film_theta_degC": film["theta_degC"]}
     return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
@@ -188,8 +188,8 @@ def header_text(cal: Calibration, command: str) -> str:
                   "static_capacity_Nm", "status"))
         + f"\n/* wc_clutch_step on the open element's series (vectors.open_drag_profile), table1 with\n"
         f" * open_clearance_m = {OPEN_CLEARANCE_M} and open_aeration_speed_rad_s = {OPEN_AERATION_SPEED_RAD_S} (DESIGN 15);"
-        " open: the\n * modelled piston below its spring; film_*: the same series with both 0 (the film alone). Every"
-        " step. */\n"
+        "\n * open: how far the modelled piston stands off the pack (0 applied .. 1 retracted, across its"
+        " spring's band);\n * film_*: the same series with both 0 (the film alone). Every step. */\n"
         + _table("wc_golden_open_drag", "wc_golden_open_drag_t", drag,
                  ("step", "slip_rpm", "torque_request_Nm", "mode", "open", "pressure_model_Pa", "torque_Nm",
                   "theta_degC", "film_torque_Nm", "film_theta_degC"))

@@ -12,7 +12,7 @@ from .constants import (MODE_LOCKED, MODE_TORQUE, RAD_S_PER_RPM, STATUS_CURRENT_
                         STATUS_OVER_TEMPERATURE, THETA_MAX_DEGC, THETA_MIN_DEGC, THETA_OVER_DEGC,
                         THETA_OVER_HYSTERESIS_K, TORQUE_MAX_NM)
 from .film import hbar_from_pressure_m
-from .friction import force_max_N, static_capacity_Nm, torque_parts
+from .friction import force_max_N, retracted_fraction, static_capacity_Nm, torque_parts
 from .inverse import holding_inverse, inverse
 from .lockup import Lockup
 from .squeeze_film import film_advance_m, film_contact_pressure_Pa, film_damping_N_s_m2
@@ -34,7 +34,8 @@ class ClutchReference:
     lag_compensation_time_s > 0 (DESIGN 9: lead_film, lead_lag); VFS lag (exact, tau) -> reached pressure ->
     apply force F = max(P A_p - F_s, 0) -> contact force (F, or with the squeeze-film state on, the asperity
     force at the film state, which then advances under F: film_advance_m) -> model torque (the piston below its
-    spring, P A_p - F_s <= 0 and no bench force: the open element's drag, friction.open_gap_m, DESIGN 15); lock-up (Lockup)
+    spring's band, friction.retracted_fraction, and no bench force: the open element's drag, friction.open_gap_m,
+    DESIGN 15); lock-up (Lockup)
     against the static capacity with the required torque (the measured torque on a bench, else
     carried_torque_Nm when given, else the request, in the lock direction); while locked the held torque
     (Lockup.torque_Nm), no heat and STATUS_LOCKED; observer advanced with |T dw| and kept in
@@ -125,10 +126,10 @@ class ClutchReference:
             force = bench_force_N
         # inside the lock band the torque keeps the lock direction (the slip's sign there is noise)
         in_band = abs(slip_rpm) * RAD_S_PER_RPM < cal.lock_slip
-        # DESIGN 15: the open element (the modelled piston below its return spring, before the kiss offset; on a
-        # bench no load on the cell) drags through its clearance, aerated
-        open_element = not (pressure * cal.piston_area - cal.return_spring_force > 0.0 if math.isnan(bench_force_N)
-                            else bench_force_N > 0.0)
+        # DESIGN 15: the open element (the modelled piston off the pack by the retracted fraction, before the
+        # kiss offset; on a bench all the way while no load on the cell) drags through its clearance, aerated
+        open_element = retracted_fraction(cal, pressure) if math.isnan(bench_force_N) else \
+            (0.0 if bench_force_N > 0.0 else 1.0)
         if self.film_on:
             contact = cal.friction_area * float(film_contact_pressure_Pa(cal, self.hbar)[0])
             parts = torque_parts(cal, abs(slip_rpm), theta_model, contact, hbar_m=self.hbar,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import math
+
 import numpy as np
 
 from .constants import RAD_S_PER_RPM
@@ -44,24 +46,44 @@ def static_capacity_Nm(cal: Calibration, theta_degC, contact_force_N):
             * cal.effective_radius * cal.friction_pairs * np.asarray(contact_force_N, dtype=float))
 
 
-def open_gap_m(cal: Calibration, hbar_m, slip_rpm):
-    """The open element's viscous gap (DESIGN 15; wc_clutch_step): the film plus the retracted piston's clearance
-    per gap, times the open pack's aeration factor, (h_bar + open_clearance) (1 + (slip / w_a)^2), w_a =
-    open_aeration_speed (0: no aeration factor). Both 0: h_bar itself."""
-    gap = np.asarray(hbar_m, dtype=float) + cal.open_clearance
+SPRING_PRELOAD_FRACTION = 0.8   # DESIGN 15: the return spring's force at the retracted piston, of F_s (wc_clutch.c)
+
+
+def retracted_fraction(cal: Calibration, pressure_Pa: float) -> float:
+    """How far the modelled piston stands off the pack (DESIGN 15; wc_clutch_step): its return spring's force
+    rises from the preload SPRING_PRELOAD_FRACTION F_s at the retracted end to F_s at the pack (the kiss point),
+    so with P A_p between the two the piston stands in between, retracted by (F_s - P A_p) / ((1 - preload) F_s)
+    in [0, 1]; 0 from P A_p >= F_s on, 1 at or below the preload (and for a NaN pressure); without a spring
+    (F_s 0) 1 without pressure, else 0."""
+    piston_N = pressure_Pa * cal.piston_area
+    band_N = (1.0 - SPRING_PRELOAD_FRACTION) * cal.return_spring_force
+    if not band_N > 0.0:                      # no spring (F_s 0): no band
+        return 0.0 if piston_N > 0.0 else 1.0
+    r = (cal.return_spring_force - piston_N) / band_N
+    return 1.0 if math.isnan(r) else min(max(r, 0.0), 1.0)
+
+
+def open_gap_m(cal: Calibration, hbar_m, slip_rpm, retracted: float = 1.0):
+    """The viscous gap of an element whose piston stands off the pack by the fraction ``retracted`` (DESIGN 15;
+    wc_clutch_step): the film plus that fraction of the retracted piston's clearance per gap, times that
+    fraction of the open pack's aeration, (h_bar + r open_clearance) (1 + r (slip / w_a)^2), w_a =
+    open_aeration_speed (0: no aeration factor). Both 0, or r = 0: h_bar itself."""
+    gap = np.asarray(hbar_m, dtype=float) + retracted * cal.open_clearance
     if cal.open_aeration_speed > 0.0:
-        gap = gap * (1.0 + (np.asarray(slip_rpm, dtype=float) * RAD_S_PER_RPM / cal.open_aeration_speed) ** 2)
+        gap = gap * (1.0 + retracted * (np.asarray(slip_rpm, dtype=float) * RAD_S_PER_RPM
+                                        / cal.open_aeration_speed) ** 2)
     return gap
 
 
 def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, friction_factor: float = 1.0,
-                 open_element: bool = False):
+                 open_element: float = 0.0):
     """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
 
     hbar_m: the film the contact force stands on; default the steady film of eq. 16 (the squeeze-film
     state of DESIGN 9 passes its own). friction_factor: the adaptation's scale of mu_f (DESIGN 12; the
-    returned mu_f carries it). open_element: the piston retracted (DESIGN 15): the viscous term shears
-    open_gap_m instead of the film (the returned h_bar stays the film's).
+    returned mu_f carries it). open_element: how far the piston stands off the pack (DESIGN 15,
+    retracted_fraction; True: all the way): the viscous term shears open_gap_m instead of the film (the
+    returned h_bar stays the film's).
 
     Torques carry the sign of the slip speed (slip >= 0 counts as positive):
     the torque transmitted through the slipping clutch, which acts against
@@ -78,7 +100,7 @@ def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, f
             if hbar_m is None else np.asarray(hbar_m, dtype=float))
     rn = cal.effective_radius * cal.friction_pairs
     coulomb = rn * mu_f * force                                          # eq. 6
-    gap = open_gap_m(cal, hbar, slip) if open_element else hbar           # DESIGN 15: the open element's drag
+    gap = open_gap_m(cal, hbar, slip, float(open_element)) if open_element else hbar   # DESIGN 15: open drag
     viscous = rn * viscosity_Pa_s(cal, theta) * cal.friction_area * speed / gap   # eq. 7
     return {
         "torque_Nm": sign * (coulomb + viscous),                         # eq. 5, 8
