@@ -75,6 +75,8 @@ class TrueElement:
         self.h = ph.h_max
         self.theta = self.oil
         self.power = 0.0
+        self._contact_h = math.nan
+        self._idle = False
         self._set_theta(self.theta)
         self._set_film(self.h)
         self._rest = True
@@ -109,7 +111,9 @@ class TrueElement:
 
     def _set_film(self, h):
         ph = self._ph
-        self.f_c, self.hbar = ph.contact(h)
+        if h != self._contact_h:           # the contact depends on h alone (the temperature changes every period)
+            self._contact_h = h
+            self.f_c, self.hbar = ph.contact(h)
         self.static = self.scale * ph.static_factor * ph.rn * ph.mu2 * self.temp * self.f_c
         self.coul_k = self.scale * ph.rn * self.temp * self.f_c
         self._set_open()
@@ -140,16 +144,19 @@ class TrueElement:
     # ------------------------------------------------------------------ the mechanics' view
     def kinetic(self, w_abs: float) -> float:
         """|T| while slipping at |slip| w_abs."""
-        ph = self._ph
-        x = self.aer_q * w_abs * w_abs
-        return self.coul_k * (ph.mu1 + ph.dmu * math.exp(-ph.r_eff * w_abs / ph.vs)) + self.visc_c * w_abs / (1.0 + x)
+        return self.kinetic_slope(w_abs)[0]
 
     def slope(self, w_abs: float) -> float:
         """d|T|/d|slip| (Stribeck + viscous with the aeration)."""
+        return self.kinetic_slope(w_abs)[1]
+
+    def kinetic_slope(self, w_abs: float) -> tuple[float, float]:
+        """(kinetic(w_abs), slope(w_abs)) with one exponential: the mechanics ask for both every substep."""
         ph = self._ph
         x = self.aer_q * w_abs * w_abs
-        return -self.coul_k * ph.dmu * (ph.r_eff / ph.vs) * math.exp(-ph.r_eff * w_abs / ph.vs) \
-            + self.visc_c * (1.0 - x) / ((1.0 + x) * (1.0 + x))
+        e = math.exp(-ph.r_eff * w_abs / ph.vs)
+        return (self.coul_k * (ph.mu1 + ph.dmu * e) + self.visc_c * w_abs / (1.0 + x),
+                -self.coul_k * ph.dmu * (ph.r_eff / ph.vs) * e + self.visc_c * (1.0 - x) / ((1.0 + x) * (1.0 + x)))
 
     # ------------------------------------------------------------------ one period
     def step_begin(self, current_mA: float) -> None:
@@ -159,10 +166,17 @@ class TrueElement:
         self.current = min(max(i, self.i_min), self.i_max)
         self.p_cmd = self.gain * self.current
         self.dp = self.P - self.p_cmd
+        # an empty piston whose pressure stays at or below the spring's preload all period (it moves from P to
+        # p_cmd) and an open film at rest: every substep would leave it as it is (substep's first branches)
+        ph = self._ph
+        self._idle = self.fill_on and self.fill == 0.0 and ph.phi != 0.0 and self.h >= ph.h_max and \
+            max(self.P, self.p_cmd) <= 0.8 * self.p_kiss
 
     def substep(self, j: int) -> None:
         """Advance the piston's fill and the film over substep j (the pressure exact within it); the film's
         torque, capacity and drag updated to its end."""
+        if self._idle:
+            return
         lag = self.lag
         p0 = self.p_cmd + self.dp * lag[2 * j]
         pm = self.p_cmd + self.dp * lag[2 * j + 1]

@@ -227,8 +227,7 @@ class Plant8:
             sk = sp[J0 + k]
             d = self.dir[k] if abs(sk) <= TINY_SLIP else (1.0 if sk > 0.0 else -1.0)
             w = abs(sk)
-            tk = joint.kinetic(w)
-            slope = joint.slope(w)
+            tk, slope = joint.kinetic_slope(w)
             f[J0 + k] = -d * tk
             if slope > 0.0 and h * slope * self.mob[k] > IMPLICIT_STIFFNESS:
                 implicit.append((k, slope))

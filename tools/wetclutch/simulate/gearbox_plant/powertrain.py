@@ -177,6 +177,9 @@ class Lockup:
     def slope(w_abs: float) -> float:
         return 0.0
 
+    def kinetic_slope(self, w_abs: float) -> tuple[float, float]:
+        return self.kin, 0.0
+
 
 class WheelBrake:
     """The service brake as a friction element between the wheels and the ground: static = kinetic = the
@@ -198,3 +201,6 @@ class WheelBrake:
     @staticmethod
     def slope(w_abs: float) -> float:
         return 0.0
+
+    def kinetic_slope(self, w_abs: float) -> tuple[float, float]:
+        return self.kin, 0.0
