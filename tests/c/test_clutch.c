@@ -446,9 +446,9 @@ static void test_engagement_edges_match_golden(void **state)
  * would hide a wrong gap); the estimate 0.02 K (the heat of those torque errors over the 1 s). The piston
  * stands off the pack by a fraction that is continuous in the pressure across its spring's band (0.8..1 F_s),
  * so no step is skipped: the rows within the band (the reference's 0 < open < 1, passed on the way up and
- * down) lie between the open drag and the film alone. The model without the open drag gives the film-only
- * column on the fully open rows: 7 to 67 times the reference's torque (checked below on the vectors, at
- * least 5), so this test fails without it. */
+ * down; the smallest fraction there 0.019) drag less than the film alone. The model without the open drag
+ * gives the film-only column on the fully open rows: 7 to 67 times the reference's torque (checked below on
+ * the vectors, at least 5), so this test fails without it. */
 static void test_open_drag_matches_golden(void **state)
 {
     (void)state;

@@ -163,7 +163,7 @@ def test_open_drag_is_the_8speed_plants(element):
         band = TrueElement(element, ref_cal, friction_scale=1.0, oil_degC=60.0, housing_degC=60.0,
                            fill_rate_gain=3.5e-3, fill_rate_max=34.0, stroke_m=stroke_m, aeration_speed=aeration,
                            dt_s=1e-3, substeps=4)
-        band.set_steady(p_Pa / cal.vfs_gain, 60.0)           # the VFS at the pressure, the piston at either end
+        band.set_steady(p_Pa / cal.vfs_gain, 60.0)           # the VFS at the pressure, the piston empty
         for _ in range(300):                                   # 0.3 s: 25 time constants
             band.step_begin(p_Pa / cal.vfs_gain)
             for j in range(4):

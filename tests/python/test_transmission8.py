@@ -66,9 +66,10 @@ def test_comfort_targets(results, case):
     print(f"{q['shift']} {case[2]}: jerk {q['peak_jerk_m_s3']:.1f} m/s^3 (limit {LIMITS[case[2]]}), excursion "
           f"{q['excursion_rpm']:.0f} rpm, tie-up {q['tie_up_Nm']:.1f} N m of {q['turbine_torque_Nm']:.0f}, inertia "
           f"{q['inertia_time_s']:.3f} s of {q['target_s']} s, new gear's speed at {q['new_speed_s']:.3f} s")
-    assert q["peak_jerk_m_s3"] <= LIMITS[case[2]], (case, q["peak_jerk_m_s3"])
+    # flare and tie-up first: a shift whose jerk is a strict xfail (4->6) is still held to them
     assert q["excursion_rpm"] <= 30.0, (case, q["excursion_rpm"])
     assert q["tie_up_fraction"] <= t8.TIE_UP_FRACTION, (case, q["tie_up_fraction"])
+    assert q["peak_jerk_m_s3"] <= LIMITS[case[2]], (case, q["peak_jerk_m_s3"])
 
 
 KICKDOWNS = [c for c in CASES if c[2] == "power-on downshift"]
