@@ -63,7 +63,7 @@ def test_no_speed_trace_violation_is_the_transmissions(low):
 
 
 def test_every_request_engages(low):
-    assert low[2]["dropped_requests"] == 0
+    assert low[2]["dropped_requests"] == len(low[2]["dropped"]) == 0     # each one listed with its time
 
 
 @pytest.mark.xfail(strict=True, reason="missed (2026-11-29): 6 of 74 shifts of the low phase end in lock-up failed:"

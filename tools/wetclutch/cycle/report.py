@@ -61,6 +61,8 @@ def evaluate(result) -> dict:
             "violations_transmission": len(theirs), "largest_speed_error_kmh": float(np.max(np.abs(
                 v - c["target_kmh"]), initial=0.0)),
             "requests": count_by_kind(result.requests), "dropped_requests": len(result.dropped),
+            "dropped": [{"t_s": r.time_s, "shift": f"{r.from_gear}->{r.to_gear}", "reason": r.reason}
+                        for r in result.dropped],
             "shifts": len(shifts), "shifts_meeting_every_limit": len(shifts) - len(bad), "by_kind": by_kind,
             "miss_causes": dict(causes), "observer_max_error_K": observer,
             "adaptation": ("on: power-on upshifts learn into their on-coming element; learned shifts per element "
@@ -129,7 +131,8 @@ def markdown(figures: dict, shifts: list) -> str:
              f"- {f['duration_s']:.0f} s driven in {f['cpu_s']:.0f} s of CPU ({f['periods_per_cpu_s']:.0f} periods/s)",
              f"- speed-trace violations (GTR 15, +-2 km/h within +-1 s): {len(f['violations'])}, of them during a"
              f" shift: {f['violations_transmission']}; largest speed error {f['largest_speed_error_kmh']:.2f} km/h",
-             f"- shift requests: {f['requests']}; never engaged: {f['dropped_requests']}",
+             f"- shift requests: {f['requests']}; never engaged: {f['dropped_requests']}" + "".join(
+                 f" ({d['shift']} at {d['t_s']:.1f} s, {d['reason']})" for d in f["dropped"]),
              f"- shifts meeting every limit of issue 29: {f['shifts_meeting_every_limit']} of {f['shifts']};"
              f" misses by cause: {f['miss_causes'] or 'none'}",
              "- observer, max |estimate - truth| per element: " + ", ".join(
