@@ -404,12 +404,7 @@ static void test_engagement_edges_match_golden(void **state)
     bool was_locked = false;
     for (size_t k = 0u; k < rows; ++k) {
         const wc_golden_edges_t *g = &wc_golden_edges[k];
-        wc_step_input_t in;
-        memset(&in, 0, sizeof in);
-        in.slip_rad_s = wc_test_rpm_to_rad_s(g->slip_rpm);
-        in.theta_oil_degC = 40.0f;
-        in.theta_housing_degC = 40.0f;
-        in.torque_request_Nm = (float)g->torque_request_Nm;
+        wc_step_input_t in = input(wc_test_rpm_to_rad_s(g->slip_rpm), 40.0f, 40.0f, (float)g->torque_request_Nm);
         in.mode = (k < 100u) ? WC_MODE_OPEN : WC_MODE_TORQUE;  /* open for the first 0.1 s */
         wc_step_output_t out;
         const wc_status_t status = wc_clutch_step(&clutch, &in, &out);
@@ -466,12 +461,7 @@ static void test_open_drag_matches_golden(void **state)
     size_t band_rows = 0u;
     for (size_t k = 0u; k < rows; ++k) {
         const wc_golden_open_drag_t *g = &wc_golden_open_drag[k];
-        wc_step_input_t in;
-        memset(&in, 0, sizeof in);
-        in.slip_rad_s = wc_test_rpm_to_rad_s(g->slip_rpm);
-        in.theta_oil_degC = 60.0f;
-        in.theta_housing_degC = 60.0f;
-        in.torque_request_Nm = (float)g->torque_request_Nm;
+        wc_step_input_t in = input(wc_test_rpm_to_rad_s(g->slip_rpm), 60.0f, 60.0f, (float)g->torque_request_Nm);
         in.mode = (g->mode > 0.5) ? WC_MODE_TORQUE : WC_MODE_OPEN;
         wc_step_output_t out;
         wc_step_output_t film_out;

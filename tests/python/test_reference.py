@@ -154,15 +154,15 @@ def test_open_drag_is_the_8speed_plants(element):
     # between its retracted end and the pack (DESIGN 15: the return spring's band, 0.8..1 F_s): the plant's piston
     # at a pressure there comes to rest where the spring balances it (fill f = (P / P_kiss - 0.8) / 0.2); the
     # reference's retracted fraction from the same pressure is 1 - f, and its drag the plant's at that stroke
+    # the nominal vehicle's feed (3.5e-3 fill volumes per s and Pa, 34 per s): the stroke's time constant
+    # 1 / (g 0.2 P_kiss), about 12 ms
+    band = TrueElement(element, ref_cal, friction_scale=1.0, oil_degC=60.0, housing_degC=60.0,
+                       fill_rate_gain=3.5e-3, fill_rate_max=34.0, stroke_m=stroke_m, aeration_speed=aeration,
+                       dt_s=1e-3, substeps=4)
     for share in (0.82, 0.9, 0.97):
         p_Pa = share * cal.return_spring_force / cal.piston_area
         r = model.retracted_fraction(ref_cal, p_Pa)
         assert r == pytest.approx((1.0 - share) / (1.0 - model.friction.SPRING_PRELOAD_FRACTION), rel=1e-12)
-        # the nominal vehicle's feed (3.5e-3 fill volumes per s and Pa, 34 per s): the stroke's time constant
-        # 1 / (g 0.2 P_kiss), about 12 ms
-        band = TrueElement(element, ref_cal, friction_scale=1.0, oil_degC=60.0, housing_degC=60.0,
-                           fill_rate_gain=3.5e-3, fill_rate_max=34.0, stroke_m=stroke_m, aeration_speed=aeration,
-                           dt_s=1e-3, substeps=4)
         band.set_steady(p_Pa / cal.vfs_gain, 60.0)           # the VFS at the pressure, the piston empty
         for _ in range(300):                                   # 0.3 s: 25 time constants
             band.step_begin(p_Pa / cal.vfs_gain)

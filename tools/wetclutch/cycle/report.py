@@ -81,21 +81,11 @@ def learned_truth(vehicle) -> dict:
     from ..shift.matrix8 import CONTROLLER, _plant_and_models, plant_path
     from ..shift.scenarios import SHIFT_TOML
     from ..calibration import shift as shift_calibration
-    from ..simulate.plant.variants import VariantTruth
+    from ..simulate.plant.variants import clutch_truth
     params, _ = _plant_and_models(str(plant_path(vehicle)))
-    gb = params.gearbox
     nodes = bands(shift_calibration.load(SHIFT_TOML).variants[CONTROLLER])["theta_nodes_degC"]
-    out = {}
-    for e in ELEMENTS:
-        plant_cal, tcu_cal = params.truth[e], gb.element(e).calibration
-        truth = VariantTruth(plant_cal=plant_cal, tcu_cal=tcu_cal, friction_scale_plant=params.friction_scale[e],
-                             # NaN where the element's model has no squeeze film (factor 0): nothing to learn
-                             film_factor=plant_cal.film_squeeze_factor / tcu_cal.film_squeeze_factor
-                             if tcu_cal.film_squeeze_factor > 0.0 else math.nan,
-                             kiss_offset_Pa=plant_cal.return_spring_force / plant_cal.piston_area
-                             - tcu_cal.return_spring_force / tcu_cal.piston_area)
-        out[e] = truth.as_dict(nodes)
-    return out
+    return {e: clutch_truth(params.truth[e], params.gearbox.element(e).calibration, params.friction_scale[e])
+            .as_dict(nodes) for e in ELEMENTS}
 
 
 def plot_learned(path: Path, learned: list, truth: dict, labels: list) -> str:
@@ -166,10 +156,10 @@ def markdown(figures: dict, shifts: list) -> str:
     return "\n".join(lines) + "\n"
 
 
-def plots(result, shifts: list, out: Path) -> list[Path]:
+def plots(result, shifts: list, out: Path, learned: dict | None = None) -> list[Path]:
     """speed.png (trace, driven speed, gear), temperatures.png (each element's estimate and truth),
     jerk.png (peak jerk per shift by type against the type's limit), learned.png (each element's learned values at
-    the cycle's end against their truth, plot_learned)."""
+    the cycle's end against their truth, plot_learned; learned: evaluate's "learned")."""
     from ..shift.transmission8 import LIMITS_JERK
     from ..util import plotting
     c = result.channels
@@ -201,9 +191,9 @@ def plots(result, shifts: list, out: Path) -> list[Path]:
     ax.set_ylabel("peak jerk m/s^3")
     ax.legend()
     paths.append(plotting.save(fig, out / "jerk.png"))
-    if result.learned:
-        truth = {e: v["truth"] for e, v in evaluate_learned(result).items()}
-        paths.append(plot_learned(out / "learned.png", [result.learned], truth, ["learned"]))
+    if result.learned and learned:
+        paths.append(plot_learned(out / "learned.png", [result.learned], {e: v["truth"] for e, v in learned.items()},
+                                  ["learned"]))
     return paths
 
 
@@ -230,7 +220,7 @@ def write(result, out: Path, name: str) -> dict:
                                                            indent=1, default=float))
         mdf.write_channels(out / f"{name}.mf4", c["t_s"], channels, f"wetclutch cycle: {result.trace.name} on"
                            f" {result.vehicle}")
-        plots(result, result.shifts, out / name)
+        plots(result, result.shifts, out / name, figures["learned"])
     return figures
 
 

@@ -38,9 +38,9 @@ from ..calibration import shift as shift_calibration
 from ..shift.scenarios import SHIFT_TOML, ShiftError
 from ..shift import transmission8
 # issue 29's limits, which issue 31 applies to every shift of the cycle
-from ..shift.transmission8 import (ELEMENTS, EXCURSION_RPM as FLARE_RPM, INERTIA_TOLERANCE as DURATION_TOLERANCE,
-                                   LIMITS_JERK, TARGET_S, THETA_K, TIE_UP_FRACTION, TYPES, AdaptValues, Transmission,
-                                   excursion_rpm, tie_up_fraction, tie_up_Nm)
+from ..shift.transmission8 import (ELEMENTS, EXCURSION_RPM, INERTIA_TOLERANCE, LIMITS_JERK, TARGET_S, THETA_K,
+                                   TIE_UP_FRACTION, TYPES, AdaptValues, Transmission, excursion_rpm, tie_up_fraction,
+                                   tie_up_Nm)
 from ..simulate.gearbox_plant import Plant8
 from .driver import Driver, DriverParams
 from .schedule import DEFAULT_SCHEDULE, load_schedule
@@ -171,14 +171,14 @@ def shift_missed(q: dict) -> list[str]:
         m.append(f"not completed (abort {q['abort']})")
     if q["peak_jerk_m_s3"] > LIMITS_JERK[q["kind"]]:
         m.append(f"jerk {q['peak_jerk_m_s3']:.1f} > {LIMITS_JERK[q['kind']]:g}")
-    if q["flare_rpm"] > FLARE_RPM:
+    if q["flare_rpm"] > EXCURSION_RPM:
         m.append(f"flare/sag {q['flare_rpm']:.0f} rpm")
     if q["tie_up_fraction"] > TIE_UP_FRACTION:
         m.append(f"tie-up {100 * q['tie_up_fraction']:.0f} %")
     t, target = q["inertia_time_s"], q["target_s"]
     stretched = q["kind"] == "power-on downshift"      # a kickdown's pace is the engine's (wc_shift.h)
-    if math.isfinite(t) and (t < (1 - DURATION_TOLERANCE) * target or
-                             (not stretched and t > (1 + DURATION_TOLERANCE) * target)):
+    if math.isfinite(t) and (t < (1 - INERTIA_TOLERANCE) * target or
+                             (not stretched and t > (1 + INERTIA_TOLERANCE) * target)):
         m.append(f"inertia {t:.2f} s of {target} s")
     th = q["theta_oncoming_degC"]
     if th and abs(th["estimate"] - th["truth"]) > THETA_K:

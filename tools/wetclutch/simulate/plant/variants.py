@@ -30,6 +30,7 @@ the bench's truth (friction scale 0.9995..1.0007 over 20..200 degC, film factor 
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,10 +110,16 @@ class VariantTruth:
                 "film_factor": self.film_factor, "kiss_offset_Pa": self.kiss_offset_Pa}
 
 
+def clutch_truth(plant_cal, tcu_cal, friction_scale: float) -> VariantTruth:
+    """The truth of a true clutch (its calibration and lining factor) against the TCU's calibration of it: the
+    film factor NaN where the TCU's model has no squeeze film (factor 0: nothing to learn)."""
+    return VariantTruth(plant_cal=plant_cal, tcu_cal=tcu_cal, friction_scale_plant=friction_scale,
+                        film_factor=plant_cal.film_squeeze_factor / tcu_cal.film_squeeze_factor
+                        if tcu_cal.film_squeeze_factor > 0.0 else math.nan,
+                        kiss_offset_Pa=plant_cal.return_spring_force / plant_cal.piston_area
+                        - tcu_cal.return_spring_force / tcu_cal.piston_area)
+
+
 def truth(params: PlantParams, tcu_cal) -> VariantTruth:
     """The truth of a plant (a variant's parameters, apply) against the TCU's clutch calibration tcu_cal."""
-    pc = params.clutch_cal
-    return VariantTruth(plant_cal=pc, tcu_cal=tcu_cal, friction_scale_plant=params.friction_scale,
-                        film_factor=pc.film_squeeze_factor / tcu_cal.film_squeeze_factor,
-                        kiss_offset_Pa=pc.return_spring_force / pc.piston_area
-                        - tcu_cal.return_spring_force / tcu_cal.piston_area)
+    return clutch_truth(params.clutch_cal, tcu_cal, params.friction_scale)
