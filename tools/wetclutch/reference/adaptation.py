@@ -12,9 +12,9 @@ The measurement (DESIGN 10, 12): in the inertia phase
  => T_imp,j = (drive_{j-1} - (slip_j - slip_{j-1}) / dt) / m,   drive = a T_t / I_t,  m = a^2/I_t + b^2/I_out,
 paired with the model torque of period j-1. The update at the shift's end (finish): rho = sum T_imp /
 sum T_model, each node's share q_i of sum w_i(theta) T_model, normalised by Q = sum q_j^2 so that the
-interpolated scale at the window's temperatures moves by the gain times its error, a node not yet learned
-following the measurement in full: s_i += clip(gain g_i s_i (rho - 1), +-step (1 - c_i / 2)), g_i = max(q_i / Q, 1 - c_i),
-in its band; the confidence c_i += gain_c q_i (1 - c_i) (c_i before the update); the kiss point from the least squares of
+interpolated scale at the window's temperatures moves by the gain times its error: each node's own step
+a_i = clip(gain (q_i / Q) s_i (rho - 1), +-step (1 - c_i / 2)), the window's step A = sum q_j a_j, and
+s_i += c_i a_i + (1 - c_i) A in its band (a node not yet learned follows the window's scale); the confidence c_i += gain_c q_i (1 - c_i) (c_i before the update); the kiss point from the least squares of
 r = T_imp - T_model on the model's Coulomb torque x1 and its Coulomb torque per newton x2; the film factor
 from the early window's ratio rho_e against rho.
 
@@ -273,12 +273,16 @@ class AdaptationReference:
             node = max(range(NODES), key=lambda i: (share[i], -i))      # the first of equal shares
             q2 = sum(q * q for q in share)                              # in [1/NODES, 1]
             band = st.scale_band
+            own = []                                                    # each node's own step
             for i in range(NODES):
-                g = max(share[i] / q2, 1.0 - v.confidence[i])
                 limit = st.scale_step * (1.0 - 0.5 * v.confidence[i])     # a confident node moves less per shift
-                step = _clip(st.scale_gain * g * v.friction_scale[i] * (rho - 1.0), -limit, limit)
-                v.friction_scale[i] = _clip(v.friction_scale[i] + step, 1.0 - band, 1.0 + band)
-                v.confidence[i] += st.confidence_gain * share[i] * (1.0 - v.confidence[i])
+                own.append(_clip(st.scale_gain * share[i] / q2 * v.friction_scale[i] * (rho - 1.0), -limit, limit))
+            window_step = sum(q * a for q, a in zip(share, own))        # the window's interpolated scale's move
+            for i in range(NODES):
+                c = v.confidence[i]
+                v.friction_scale[i] = _clip(v.friction_scale[i] + c * own[i] + (1.0 - c) * window_step,
+                                            1.0 - band, 1.0 + band)
+                v.confidence[i] += st.confidence_gain * share[i] * (1.0 - c)
             # the kiss point: r = b1 x1 + b2 x2, b1 = s - 1, b2 = -s dF
             prod = w.s11 * w.s22
             det = prod - w.s12 * w.s12
