@@ -86,6 +86,15 @@ typedef struct {
     float carried_torque_Nm;
     /* The adaptation's correction (wc_adapt_correction); zero: none. */
     wc_model_correction_t correction;
+    /* true (WC_MODE_TORQUE, slipping): a request below the drag the element
+     * has at its kiss point retracts the piston into its return spring's band
+     * (DESIGN 15: the pressure between the spring's preload and the kiss
+     * point) by the fraction whose open drag is the request; 0 or less: all
+     * the way, the spring's preload. An off-going element released under
+     * control needs it: at its kiss point a dragging pack may carry all of a
+     * light load. false (zero-initialized): no request goes below the kiss
+     * point. Without an open drag calibrated it changes nothing. */
+    bool band_release;
 } wc_step_input_t;
 
 typedef struct {

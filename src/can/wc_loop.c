@@ -347,7 +347,7 @@ static WC_NOINLINE uint32_t encode_whole_shift(wc_loop_t *loop, wc_can_frame_t o
 }
 
 /* prepare() sets the clutch input field by field: all of them (a new field fails here). */
-WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 15u * 4u, the_loop_sets_every_field_of_the_clutch_input);
+WC_STATIC_ASSERT(sizeof(wc_step_input_t) == 16u * 4u, the_loop_sets_every_field_of_the_clutch_input);
 WC_STATIC_ASSERT(WC_CAN_STATUS_BITS <= 16u, status_bits_below_the_step_flags);
 
 /* The frames of this period, the inputs' freshness and the safe state, then
@@ -416,6 +416,7 @@ static WC_NOINLINE uint32_t prepare(wc_loop_t *loop)
     in->lag_compensation.time_s = 0.0f;
     in->lag_compensation.vfs_gain = 0.0f;
     in->theta_from_oil = false;
+    in->band_release = false;
     in->carried_torque_Nm = 0.0f;
     in->correction.friction_scale_delta = 0.0f;  /* the shift controller sets it (DESIGN 12) */
     in->correction.film_factor_delta = 0.0f;

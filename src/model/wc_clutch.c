@@ -149,6 +149,27 @@ static inline float open_gap_m(const wc_calibration_t *cal, float hbar_m, float 
     return gap_m;
 }
 
+/* DESIGN 15, the release into the band (wc_step_input_t.band_release): the retracted fraction r whose viscous
+ * drag at the point is viscous_Nm (the request less the film's contact torque), the inverse of open_gap_m:
+ * gap(r) = (h_bar + r c)(1 + r a^2) = G = T_v0 / viscous_Nm, a = slip / w_a, T_v0 the point's viscous
+ * torque times its gap. The quadratic c a^2 r^2 + (c + h_bar a^2) r - (G - h_bar) = 0 in the form without a
+ * cancellation, r = 2 (G - h_bar) / (B + sqrt(B^2 + 4 c a^2 (G - h_bar))), B = c + h_bar a^2; 0 where the
+ * film alone drags less than wanted (G <= h_bar), 1 where even the whole gap drags more (and for a request
+ * at or below 0), so G - h_bar <= gap(1) - h_bar stays bounded (h_bar <= 1 mm, c <= 5 mm, a^2 <= 1.1e6). */
+static float band_fraction(const wc_calibration_t *cal, const wc_torque_point_t *point, float viscous_Nm,
+                           float hbar_m, float slip_rad_s)
+{
+    const float whole_gap_m = open_gap_m(cal, hbar_m, 1.0f, slip_rad_s);
+    if (!(viscous_Nm > 0.0f) || !(point->viscous_Nm_m < viscous_Nm * whole_gap_m)) { return 1.0f; }  /* NaN: 1 */
+    const float excess_m = point->viscous_Nm_m / viscous_Nm - hbar_m;  /* G - h_bar, < gap(1) - h_bar */
+    if (!(excess_m > 0.0f)) { return 0.0f; }
+    const float a = (cal->open_aeration_speed_rad_s > 0.0f) ? (slip_rad_s / cal->open_aeration_speed_rad_s) : 0.0f;
+    const float c_m = cal->open_clearance_m;
+    const float b_m = c_m + hbar_m * a * a;  /* > 0: h_bar > 0, and an open drag calibrated */
+    const float r = 2.0f * excess_m / (b_m + sqrtf(b_m * b_m + 4.0f * c_m * a * a * excess_m));
+    return (r > 0.0f) ? ((r < 1.0f) ? r : 1.0f) : 0.0f;
+}
+
 /* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
 static bool nonzero(float x) { return (x < 0.0f) || (x > 0.0f); }
 
@@ -243,6 +264,17 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
+    const bool open_drag = (model->cal->open_clearance_m > 0.0f) || (model->cal->open_aeration_speed_rad_s > 0.0f);
+    if (in->band_release && open_drag && (in->mode == WC_MODE_TORQUE) && !clutch->lockup.locked && !(inv.force_N > 0.0f)) {
+        /* DESIGN 15: below the kiss point's drag, into the spring's band (before the learned kiss offset, as
+         * the forward model's retracted fraction) */
+        const wc_calibration_t *c = model->cal;
+        const float gap_hbar_m = film ? hbar_m : wc_film_hbar_near_m(&c->film, 0.0f, WC_FILM_NO_SEGMENT);
+        const float contact_Nm = film ? (point.coulomb_Nm_per_N * c->friction_area_m2 * contact.pressure_Pa) : 0.0f;
+        const float r = band_fraction(c, &point, u->torque_request_Nm - contact_Nm, gap_hbar_m, u->slip_rad_s);
+        inv.pressure_Pa = c->return_spring_force_N * (1.0f - r * (1.0f - WC_SPRING_PRELOAD_FRACTION)) / c->piston_area_m2;
+        status |= wc_vfs_current_mA(c, inv.pressure_Pa, &inv.current_mA);
+    }
     const wc_lag_compensation_t *lag = &in->lag_compensation;
     const bool lead = (in->mode == WC_MODE_TORQUE) && lag_time_valid(lag->time_s) && (lag->vfs_gain > 0.0f) &&
                       (lag->vfs_gain <= FLT_MAX);  /* also NaN: off */
@@ -262,8 +294,7 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     /* DESIGN 15: how far the piston stands off the pack (before the learned kiss offset); without an open
      * drag calibrated (both fields 0) it changes nothing, and is not computed */
     const wc_calibration_t *drag_cal = model->cal;
-    float retracted = ((drag_cal->open_clearance_m > 0.0f) || (drag_cal->open_aeration_speed_rad_s > 0.0f))
-                          ? retracted_fraction(drag_cal, clutch->pressure_model_Pa) : 0.0f;
+    float retracted = open_drag ? retracted_fraction(drag_cal, clutch->pressure_model_Pa) : 0.0f;
     if (corrected && nonzero(correction.kiss_offset_N)) {
         /* DESIGN 12: the learned kiss point moves the spring's preload: F = P A_p - F_s - offset, within
          * [0, WC_FORCE_MAX_N] (|offset| <= WC_CORRECTION_KISS_MAX_N) */

@@ -392,6 +392,7 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
     in->carried_torque_Nm = 0.0f;
     in->lag_compensation = shift->lag_compensation;
     in->theta_from_oil = (cal->theta_source == (uint32_t)WC_SHIFT_THETA_OIL);
+    in->band_release = false;
     const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
     in->correction = none;
     if (wc_shift_phase_running(shift->phase) || (shift->phase == (uint32_t)WC_SHIFT_LOCKED)) {
@@ -482,6 +483,7 @@ static WC_NOINLINE void offgoing_input(wc_shift_t *shift, const wc_shift_calibra
     in->carried_torque_Nm = 0.0f;
     in->lag_compensation = shift->offgoing_lag;
     in->theta_from_oil = false;
+    in->band_release = false;
     const wc_model_correction_t none = { 0.0f, 0.0f, 0.0f };
     in->correction = none;
     bool handing_over = false;

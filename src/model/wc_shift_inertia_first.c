@@ -387,6 +387,7 @@ static void set_input(wc_step_input_t *in, wc_clutch_mode_t mode, float request_
     in->carried_torque_Nm = (mode == WC_MODE_TORQUE) ? wc_shift_clamp_torque_Nm(carried_Nm) : 0.0f;
     in->lag_compensation = *lag;
     in->theta_from_oil = false;
+    in->band_release = false;
     in->correction = none;
 }
 
@@ -474,6 +475,9 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     /* what it carries while it holds (the lock-up's decision: below it, it slips) */
     set_input(offgoing->in, off_mode, r.offgoing_Nm, offgoing_carried_Nm(cal, shift->turbine_torque_Nm),
               &shift->offgoing_lag);
+    /* DESIGN 15: in the inertia phase the off-going element may release below its kiss point (at a light
+     * load its pack's drag there carries all the turbine torque, and the turbine never reaches the new gear) */
+    offgoing->in->band_release = inertia;
     if (shift->phase == (uint32_t)WC_SHIFT_INERTIA) { shift->request_Nm = wc_shift_clamp_torque_Nm(r.offgoing_Nm); }
 
     (void)wc_clutch_step(clutch, in, out);

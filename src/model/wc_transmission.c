@@ -309,6 +309,7 @@ bool wc_transmission_step(wc_transmission_t *tx, const wc_transmission_config_t 
         in->lag_compensation.time_s = 0.0f;
         in->lag_compensation.vfs_gain = 0.0f;
         in->theta_from_oil = false;
+        in->band_release = false;
         in->correction = none;
         in->bench.valid = false;
     }

@@ -444,12 +444,19 @@ static void test_engagement_edges_match_golden(void **state)
  * down; the smallest fraction there 0.019) drag less than the film alone. The model without the open drag
  * gives the film-only column on the fully open rows: 7 to 67 times the reference's torque (checked below on
  * the vectors, at least 5), so this test fails without it. */
-static void test_open_drag_matches_golden(void **state)
+/* table1 with the 8-speed element's open drag of the golden vectors (vectors.OPEN_*) */
+static wc_calibration_t open_drag_calibration(void)
 {
-    (void)state;
     wc_calibration_t cal = wc_table1_calibration;
     cal.open_clearance_m = 1.875e-4f;             /* vectors.OPEN_CLEARANCE_M */
     cal.open_aeration_speed_rad_s = 157.08f;      /* vectors.OPEN_AERATION_SPEED_RAD_S */
+    return cal;
+}
+
+static void test_open_drag_matches_golden(void **state)
+{
+    (void)state;
+    const wc_calibration_t cal = open_drag_calibration();
     wc_clutch_t clutch;
     wc_clutch_t film_only;
     assert_int_equal(wc_clutch_init(&clutch, &cal, 60.0f), WC_CAL_OK);
@@ -502,6 +509,51 @@ static void test_open_drag_matches_golden(void **state)
     assert_true(band_rows >= 10u);  /* the band's rows are compared, not only its two ends */
     /* the heat: the film alone overestimates the open pack's temperature (the reference's last row) */
     assert_true(wc_golden_open_drag[rows - 1u].film_theta_degC - wc_golden_open_drag[rows - 1u].theta_degC > 5.0);
+}
+
+/* The release into the spring's band (DESIGN 15, wc_step_input_t.band_release) against the double-precision
+ * reference (wc_golden_band, vectors.band_profile; the reference solves the gap by bisection, the firmware by
+ * the quadratic's closed form): the open element's calibration above, torque control at 400 and 1500 rpm through
+ * requests of 0..5 Nm (below the kiss point's drag), 150 Nm and back. Tolerances: current 1e-4 relative +
+ * 1e-3 mA (float against double; the band's fraction is a smooth function of the request); the modelled
+ * pressure 1e-4 relative (the VFS lag in float); the torque as the open-drag test. Without band_release the
+ * same series never commands below the kiss point's current: that the band is used is checked on the rows. */
+static void test_band_release_matches_golden(void **state)
+{
+    (void)state;
+    const wc_calibration_t cal = open_drag_calibration();
+    wc_clutch_t clutch;
+    wc_clutch_t kiss;
+    assert_int_equal(wc_clutch_init(&clutch, &cal, 60.0f), WC_CAL_OK);
+    assert_int_equal(wc_clutch_init(&kiss, &cal, 60.0f), WC_CAL_OK);
+    const float kiss_mA = cal.return_spring_force_N / cal.piston_area_m2 / cal.vfs_gain_Pa_per_mA;
+    const size_t rows = WC_TEST_COUNT(wc_golden_band);
+    wc_test_worst_t current_worst = { 0.0, -1 };
+    size_t band_rows = 0u;
+    size_t below_kiss = 0u;
+    for (size_t k = 0u; k < rows; ++k) {
+        const wc_golden_band_t *g = &wc_golden_band[k];
+        wc_step_input_t in = input(wc_test_rpm_to_rad_s(g->slip_rpm), 60.0f, 60.0f, (float)g->torque_request_Nm);
+        in.band_release = true;
+        wc_step_output_t out;
+        (void)wc_clutch_step(&clutch, &in, &out);
+        WC_CHECK_CLOSE("current_mA", (long)k, out.current_mA, g->current_mA, 1e-4, 1e-3);
+        wc_test_worst_update(&current_worst, fabs((double)out.current_mA - g->current_mA) /
+                                                 (1e-4 * fabs(g->current_mA) + 1e-3), (long)k);
+        WC_CHECK_CLOSE("pressure_model_Pa", (long)k, out.pressure_model_Pa, g->pressure_model_Pa, 1e-4, 0.0);
+        WC_CHECK_CLOSE("torque_Nm", (long)k, out.model.torque_Nm, g->torque_Nm, 1e-3, 1e-3);
+        assert_int_equal((int)out.status, g->status);
+        if ((g->open > 0.0) && (g->open < 1.0)) { ++band_rows; }
+        if (g->current_mA < (double)kiss_mA - 0.5) { ++below_kiss; }
+        in.band_release = false;  /* the same input without: the kiss point at the least */
+        wc_step_output_t kiss_out;
+        (void)wc_clutch_step(&kiss, &in, &kiss_out);
+        WC_CHECK(kiss_out.current_mA >= kiss_mA - 1e-3f, "step %zu: %g mA below the kiss point without the band", k,
+                 (double)kiss_out.current_mA);
+    }
+    wc_test_worst_print("band release current (of tol.)", &current_worst, 1.0);
+    assert_true(band_rows >= 100u);      /* part-way into the band, not only its two ends */
+    assert_true(below_kiss >= 300u);     /* the requests below the kiss point's drag went below its current */
 }
 
 /* Film state off (film_squeeze_factor = 0, table1): the step's torque is the paper's steady model, bit for
@@ -578,6 +630,7 @@ int main(void)
         cmocka_unit_test(test_thermal_envelope_matches_golden),
         cmocka_unit_test(test_engagement_edges_match_golden),
         cmocka_unit_test(test_open_drag_matches_golden),
+        cmocka_unit_test(test_band_release_matches_golden),
         cmocka_unit_test(test_film_off_is_the_steady_model_bit_for_bit),
         cmocka_unit_test(test_lockup_hysteresis_and_dwell),
     };

@@ -344,7 +344,7 @@ static void test_over_temperature_no_oscillation(void **state)
     (void)state;
     wc_clutch_t clutch;
     assert_int_equal(wc_clutch_init(&clutch, &wc_table1_calibration, 120.0f), WC_CAL_OK);
-    const wc_step_input_t in = { 300.0f, 120.0f, 120.0f, 400.0f, WC_MODE_TORQUE, { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f } };
+    const wc_step_input_t in = { 300.0f, 120.0f, 120.0f, 400.0f, WC_MODE_TORQUE, { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f }, false };
     wc_step_output_t out;
     float previous_mA = 0.0f;
     int jumps = 0;
@@ -368,7 +368,7 @@ static void test_over_temperature_no_oscillation(void **state)
     printf("    hot clutch: over-temperature from step %d, theta %.1f degC at 6 s, %d current jumps > 50 mA\n",
            over_on, (double)clutch.theta_degC, jumps);
     /* cooling: the bit clears only below the threshold minus the hysteresis */
-    const wc_step_input_t cool = { 0.0f, 40.0f, 40.0f, 0.0f, WC_MODE_OPEN, { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f } };
+    const wc_step_input_t cool = { 0.0f, 40.0f, 40.0f, 0.0f, WC_MODE_OPEN, { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f }, false };
     int cleared = -1;
     for (int k = 0; k < 20000 && cleared < 0; ++k) {
         const wc_status_t status = wc_clutch_step(&clutch, &cool, &out);

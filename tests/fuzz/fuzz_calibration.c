@@ -258,17 +258,20 @@ static void evaluate(const wc_calibration_t *c)
     wc_clutch_t clutch;
     fz_context("wc_clutch_init(20 degC)", 0u);
     FZ_CHECK(wc_clutch_init(&clutch, c, 20.0f) == WC_CAL_OK, "wc_clutch_init rejects an accepted calibration");
-    static const wc_clutch_mode_t modes[3] = { WC_MODE_TORQUE, WC_MODE_LOCKED, WC_MODE_OPEN };
+    /* the fourth: torque control released into the spring's band below the kiss point's drag (DESIGN 15) */
+    static const wc_clutch_mode_t modes[4] = { WC_MODE_TORQUE, WC_MODE_LOCKED, WC_MODE_OPEN, WC_MODE_TORQUE };
     unsigned n = 0u;
     for (size_t k = 0u; k < N_THETAS; ++k) {
         for (size_t s = 0u; s < N_SLIPS; ++s) {
             for (size_t q = 0u; q < N_REQUESTS; ++q) {
-                for (size_t m = 0u; m < 3u; ++m) {
+                for (size_t m = 0u; m < 4u; ++m) {
                     const wc_step_input_t in = { slips[s], thetas[k], thetas[k], requests[q], modes[m],
-                                                 { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f } };
+                                                 { false, 0.0f, 0.0f }, { 0.0f, 0.0f }, false, 0.0f, { 0.0f, 0.0f, 0.0f },
+                                                 m == 3u };
                     fz_context("wc_clutch_step(slip, oil = housing, request; mode)", ++n);
                     fz_arg(slips[s]); fz_arg(thetas[k]); fz_arg(requests[q]);
                     fz_ctx.iargs[0] = (long)modes[m];
+                    fz_ctx.iargs[1] = (m == 3u) ? 1 : 0;  /* band_release */
                     wc_step_output_t out;
                     const wc_status_t st = wc_clutch_step(&clutch, &in, &out);
                     FZ_CHECK((st & (WC_STATUS_INPUT_INVALID | WC_STATUS_NOT_INITIALISED)) == 0u,

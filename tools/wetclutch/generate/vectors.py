@@ -98,6 +98,26 @@ def open_drag_profile(cal: Calibration):
             "mode": np.where(torque, model.MODE_TORQUE, model.MODE_OPEN)}
 
 
+BAND_SLIPS_RPM = (400.0, 1500.0)
+BAND_REQUESTS_NM = (0.0, 0.5, 2.0, 5.0, 150.0, 1.0, 0.2)     # 60 ms each, at each slip
+
+
+def band_profile(cal: Calibration):
+    """The release into the spring's band (DESIGN 15; band_release on every step) in 0.84 s: torque control at
+    each slip of BAND_SLIPS_RPM (0.42 s each) through the requests of BAND_REQUESTS_NM (60 ms each): from the
+    solenoid's minimum at 0 Nm, into the band at the drags below the kiss point's, applied at 150 Nm, released
+    again. Oil and housing at 60 degC, the estimate starting there."""
+    n = int(round(0.84 / cal.period))
+    k = np.arange(n)
+    t = k * cal.period
+    per_slip = len(BAND_REQUESTS_NM)
+    level = np.minimum((t / 0.06 + 1e-9).astype(int), 2 * per_slip - 1)
+    return {"step": k.astype(float), "slip_rpm": np.asarray(BAND_SLIPS_RPM)[level // per_slip],
+            "theta_oil_degC": np.full(n, 60.0), "theta_housing_degC": np.full(n, 60.0),
+            "torque_request_Nm": np.asarray(BAND_REQUESTS_NM)[level % per_slip],
+            "mode": np.full(n, model.MODE_TORQUE)}
+
+
 def _c_double(x: float) -> str:
     return f"{x:.9g}" if math.isfinite(x) else "NAN"
 
@@ -152,6 +172,10 @@ def header_text(cal: Calibration, command: str) -> str:
                               oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
     drag = {**oin, **oout, "open": np.array([model.retracted_fraction(cal, p) for p in oout["pressure_model_Pa"]]),
             "film_torque_Nm": film["torque_Nm"], "film_theta_degC": film["theta_degC"]}
+    bin_ = band_profile(open_cal)
+    bout = model.clutch_steps(open_cal, bin_["slip_rpm"], bin_["theta_oil_degC"], bin_["theta_housing_degC"],
+                              bin_["torque_request_Nm"], mode=bin_["mode"], theta_start_degC=60.0, band_release=True)
+    band = {**bin_, **bout, "open": np.array([model.retracted_fraction(cal, p) for p in bout["pressure_model_Pa"]])}
     return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
@@ -168,7 +192,9 @@ def header_text(cal: Calibration, command: str) -> str:
         "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, torque_Nm, hbar_um, contact_force_N,"
         " static_capacity_Nm; int status; } wc_golden_edges_t;\n"
         "typedef struct { double step, slip_rpm, torque_request_Nm, mode, open, pressure_model_Pa, torque_Nm,"
-        " theta_degC, film_torque_Nm, film_theta_degC; } wc_golden_open_drag_t;\n\n"
+        " theta_degC, film_torque_Nm, film_theta_degC; } wc_golden_open_drag_t;\n"
+        "typedef struct { double step, slip_rpm, torque_request_Nm, current_mA, pressure_model_Pa, open, torque_Nm;"
+        " int status; } wc_golden_band_t;\n\n"
         + _table("wc_golden_torque", "wc_golden_torque_t", {**tin, **tout},
                  ("slip_rpm", "theta_degC", "force_N", "torque_Nm", "coulomb_Nm", "viscous_Nm", "hbar_um", "mu_f"))
         + "\n" + _table("wc_golden_inverse", "wc_golden_inverse_t", {**iin, **iout},
@@ -193,6 +219,12 @@ def header_text(cal: Calibration, command: str) -> str:
         + _table("wc_golden_open_drag", "wc_golden_open_drag_t", drag,
                  ("step", "slip_rpm", "torque_request_Nm", "mode", "open", "pressure_model_Pa", "torque_Nm",
                   "theta_degC", "film_torque_Nm", "film_theta_degC"))
+        + f"\n/* wc_clutch_step with band_release on the band series (vectors.band_profile), the open element's\n"
+        " * calibration above (DESIGN 15: a request below the kiss point's drag retracts the piston into its\n"
+        " * spring's band; open: how far, from the modelled pressure). Every step. */\n"
+        + _table("wc_golden_band", "wc_golden_band_t", band,
+                 ("step", "slip_rpm", "torque_request_Nm", "current_mA", "pressure_model_Pa", "open", "torque_Nm",
+                  "status"))
         + adapt_vectors.header_part(cal)
         + "\n#endif /* WC_GOLDEN_VECTORS_H */\n"
     )

@@ -18,7 +18,8 @@ TCU's is). Holding in a gear: the holding need x 1.3, at least 10 Nm.
 Scenarios (SCENARIOS): per type, the shift, the pedal and the turbine speed at the request:
   power-on upshift    g -> g+1, the pedal for `load` of full load at 2500 rpm
   power-off upshift   g -> g+1, pedal 0 (tip-out: the engine drags) at 2500 rpm
-  power-on downshift  g -> g-1, pedal 1 (kickdown) at 1800 rpm
+  power-on downshift  g -> g-1, the pedal for `load` of full load at 1800 rpm (100 %: the kickdown; 25 %: a
+                      part-load downshift on the schedule's down line, which the drive cycle makes most often)
   power-off downshift g -> g-1, pedal 0 (coast) at 1300 rpm
 
 Quality (from the plant's truth): completed (AbortReason 0) and the end gear by truth (every closed element
@@ -66,7 +67,7 @@ AFTER_S = 0.3                                # run on after the shift's end: the
 TYPES = {0: "power-on upshift", 1: "power-off upshift", 2: "power-on downshift", 3: "power-off downshift"}
 # type -> (direction, pedal (None: for the load), turbine rpm at the request)
 SCENARIOS = {"power-on upshift": (+1, None, 2500.0), "power-off upshift": (+1, 0.0, 2500.0),
-             "power-on downshift": (-1, 1.0, 1800.0), "power-off downshift": (-1, 0.0, 1300.0)}
+             "power-on downshift": (-1, None, 1800.0), "power-off downshift": (-1, 0.0, 1300.0)}
 
 
 class _Step(ctypes.Structure):

@@ -29,7 +29,7 @@ from .film import (FilmTable, contact_pressure_Pa, film_domain, film_slope_m_per
                    hbar_from_pressure_m, separation_from_pressure_m)
 from .squeeze_film import (FilmDynamics, film_advance_m, film_contact_pressure_Pa, film_damping_N_s_m2,
                            reynolds_factor_m4, separation_from_hbar_m)
-from .friction import (force_max_N, friction_coefficient, open_gap_m, retracted_fraction, static_capacity_Nm,
+from .friction import (band_fraction, band_pressure_Pa, force_max_N, friction_coefficient, open_gap_m, retracted_fraction, static_capacity_Nm,
                        torque_at_film_Nm, torque_parts, viscosity_Pa_s, viscosity_slope_Pa_s_per_K)
 from .inverse import holding_inverse, inverse
 from .thermal import thermal_decay, thermal_observer, thermal_steady_degC
@@ -45,7 +45,7 @@ __all__ = [
     "THETA_OVER_DEGC", "THETA_OVER_HYSTERESIS_K", "TORQUE_MAX_NM", "clutch_steps", "contact_pressure_Pa",
     "film_advance_m", "film_contact_pressure_Pa", "film_damping_N_s_m2", "film_domain", "film_slope_m_per_Pa",
     "film_thickness_m", "force_max_N", "friction_coefficient", "hbar_from_pressure_m", "holding_inverse", "inverse",
-    "open_gap_m", "retracted_fraction", "reynolds_factor_m4", "separation_from_hbar_m", "separation_from_pressure_m",
+    "band_fraction", "band_pressure_Pa", "open_gap_m", "retracted_fraction", "reynolds_factor_m4", "separation_from_hbar_m", "separation_from_pressure_m",
     "static_capacity_Nm",
     "thermal_decay", "thermal_observer", "thermal_steady_degC", "torque_at_film_Nm", "torque_parts",
     "viscosity_Pa_s", "viscosity_slope_Pa_s_per_K",

@@ -12,7 +12,8 @@ from .constants import (MODE_LOCKED, MODE_TORQUE, RAD_S_PER_RPM, STATUS_CURRENT_
                         STATUS_OVER_TEMPERATURE, THETA_MAX_DEGC, THETA_MIN_DEGC, THETA_OVER_DEGC,
                         THETA_OVER_HYSTERESIS_K, TORQUE_MAX_NM)
 from .film import hbar_from_pressure_m
-from .friction import force_max_N, retracted_fraction, static_capacity_Nm, torque_parts
+from .friction import (band_fraction, band_pressure_Pa, force_max_N, retracted_fraction, static_capacity_Nm,
+                       torque_parts)
 from .inverse import holding_inverse, inverse
 from .lockup import Lockup
 from .squeeze_film import film_advance_m, film_contact_pressure_Pa, film_damping_N_s_m2
@@ -44,7 +45,10 @@ class ClutchReference:
     correction: the adaptation's (model/correction.py, DESIGN 12): mu_f scaled in the torque, the inverse and
     the static capacity, the film's damping scaled in its advance and the film lead, the kiss offset a change
     of the spring's preload both ways (contact force max(P A_p - F_s - offset, 0), the wanted contact force F
-    commanded at max(F + F_s + offset, 0) / A_p); None or out of range: none.
+    commanded at max(F + F_s + offset, 0) / A_p); None or out of range: none. band_release (DESIGN 15;
+    wc_step_input_t.band_release): in torque control, slipping, with an open drag calibrated, a request the
+    inverse gives no force for commands the pressure in the return spring's band whose open drag is the request
+    (friction.band_fraction; before the kiss offset, as the retracted fraction).
     The inputs are taken as valid (the frame loop's reference, hil/replay.py, holds invalid ones)."""
 
     def __init__(self, cal: Calibration, theta_start_degC: float):
@@ -96,7 +100,7 @@ class ClutchReference:
     def step(self, slip_rpm: float, oil_degC: float, housing_degC: float, request_Nm: float, mode: int,
              bench_force_N: float = math.nan, bench_torque_Nm: float = math.nan, lag_compensation_time_s: float = 0.0,
              theta_from_oil: bool = False, carried_torque_Nm: float = 0.0,
-             correction: Correction | None = None) -> dict:
+             correction: Correction | None = None, band_release: bool = False) -> dict:
         cal = self.cal
         corr = effective(correction)
         lockup = self.lockup
@@ -110,6 +114,21 @@ class ClutchReference:
             current = cal.vfs_current_max if mode == MODE_LOCKED else cal.vfs_current_min
             force_cmd = max(cal.vfs_gain * current * cal.piston_area - cal.return_spring_force, 0.0)
             status = 0
+        open_drag = cal.open_clearance > 0.0 or cal.open_aeration_speed > 0.0
+        if band_release and open_drag and mode == MODE_TORQUE and not lockup.locked and not force_cmd > 0.0:
+            # DESIGN 15: a request below the kiss point's drag retracts the piston into its spring's band: the
+            # fraction whose open drag (plus the film's contact torque) is the request
+            hbar = self.hbar if self.film_on else float(hbar_from_pressure_m(cal, 0.0))
+            contact = cal.friction_area * float(film_contact_pressure_Pa(cal, hbar)[0]) if self.film_on else 0.0
+            at_film = torque_parts(cal, abs(slip_rpm), theta_model, contact, hbar_m=hbar,
+                                   friction_factor=corr.friction_factor)
+            r = band_fraction(cal, request_Nm - abs(float(at_film["coulomb_Nm"])),
+                              abs(float(at_film["viscous_Nm"])) * hbar, hbar, slip_rpm)
+            current = band_pressure_Pa(cal, r) / cal.vfs_gain
+            if current > cal.vfs_current_max:
+                current, status = cal.vfs_current_max, status | STATUS_CURRENT_CLAMPED
+            elif current < cal.vfs_current_min:
+                current, status = cal.vfs_current_min, status | STATUS_CURRENT_CLAMPED
         lead = mode == MODE_TORQUE and lag_compensation_time_s > 0.0
         if lead:
             current = self._lead_film(theta_model, lag_compensation_time_s, force_cmd, current, corr)
@@ -175,11 +194,11 @@ class ClutchReference:
 
 
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
-                 mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None):
+                 mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None, band_release=False):
     """The firmware's wc_clutch_step, composed in double precision, one row per period (ClutchReference).
     Returns a dict of arrays; theta_degC[k] is the estimate used in step k (before its update). On a bench
     (rows where bench_force_N / bench_torque_Nm are given and not NaN) the torque model uses the measured force
-    and the observer's heat input the measured torque."""
+    and the observer's heat input the measured torque. band_release: every step's (ClutchReference.step)."""
     slip = np.asarray(slip_rpm, dtype=float)
     n = slip.size
     oil = np.broadcast_to(np.asarray(theta_oil_degC, dtype=float), (n,))
@@ -193,7 +212,7 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     out = {k: np.empty(n) for k in CLUTCH_OUTPUTS}
     for k in range(n):
         row = ref.step(float(slip[k]), float(oil[k]), float(housing[k]), float(request[k]), int(modes[k]),
-                       float(measured[k]), float(measured_torque[k]))
+                       float(measured[k]), float(measured_torque[k]), band_release=bool(band_release))
         for key in CLUTCH_OUTPUTS:
             out[key][k] = row[key]
     out["status"] = out["status"].astype(int)

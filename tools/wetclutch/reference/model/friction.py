@@ -75,6 +75,31 @@ def open_gap_m(cal: Calibration, hbar_m, slip_rpm, retracted: float = 1.0):
     return gap
 
 
+def band_fraction(cal: Calibration, viscous_Nm: float, viscous_Nm_m: float, hbar_m: float, slip_rpm: float) -> float:
+    """The release into the spring's band (DESIGN 15; wc_step_input_t.band_release): the retracted fraction r
+    in [0, 1] whose open gap makes the viscous drag viscous_Nm, viscous_Nm_m / open_gap_m(r) = viscous_Nm
+    (viscous_Nm_m: the viscous torque times its gap at this slip and temperature). The gap rises with r, so
+    bisection on it (60 halvings: below a double's resolution); 0 where the film alone drags less than wanted,
+    1 where the whole gap drags more, and for a wanted drag at or below 0."""
+    if not viscous_Nm > 0.0:
+        return 1.0
+    wanted_gap = viscous_Nm_m / viscous_Nm
+    if float(open_gap_m(cal, hbar_m, slip_rpm, 1.0)) <= wanted_gap:
+        return 1.0
+    if float(open_gap_m(cal, hbar_m, slip_rpm, 0.0)) >= wanted_gap:
+        return 0.0
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if float(open_gap_m(cal, hbar_m, slip_rpm, mid)) < wanted_gap else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def band_pressure_Pa(cal: Calibration, retracted: float) -> float:
+    """The piston pressure that stands the piston off the pack by ``retracted`` (retracted_fraction's inverse)."""
+    return cal.return_spring_force * (1.0 - retracted * (1.0 - SPRING_PRELOAD_FRACTION)) / cal.piston_area
+
+
 def torque_parts(cal: Calibration, slip_rpm, theta_degC, force_N, hbar_m=None, friction_factor: float = 1.0,
                  open_element: float = 0.0):
     """Eq. 3-8: dict of total/coulomb/viscous torque (Nm), h_bar (m), mu_f.
