@@ -49,17 +49,18 @@
  *     gain times its error (Q = sum_j q_j^2 > 0):
  *         a_i = clip(adapt_scale_gain (q_i / Q) s_i (rho - 1), +-adapt_scale_step (1 - c_i / 2))
  *     (node i's own step; c_i the confidence before the update: a confident
- *     node moves at most half a step, so one faulty shift costs it less), the
- *     window's step A = sum_j q_j a_j (what the own steps move the window's
- *     interpolated scale by), and
- *         s_i += c_i a_i + (1 - c_i) A,
+ *     node's own step is at most half a step, so one faulty shift costs it
+ *     less), the window's interpolated scale after the own steps
+ *     L = sum_j q_j (s_j + a_j), and
+ *         s_i += clip(c_i a_i + (1 - c_i) (L - s_i), +-adapt_scale_step),
  *     clipped to [1 - adapt_scale_band, 1 + adapt_scale_band]: a node not yet
- *     learned follows the window's scale, a smooth prior. Its change over many
- *     shifts is then the learned nodes' net change; a node that followed each
- *     shift's error itself, outside every window (no feedback through rho),
- *     summed the errors and drifted (issue 31, three low phases of the drive
- *     cycle: element C's 120 degC node at 1.25 against a truth of 1.015,
- *     its 80 degC node at 1.07; with this rule 1.10 and 1.09, settled);
+ *     learned takes the window's scale, a smooth prior, at most a step per
+ *     shift. It holds the level the learned nodes hold, whatever the shares
+ *     of the windows; a node that took each shift's error itself (or each
+ *     shift's change of the window's scale), outside every window and so
+ *     without feedback through rho, summed the errors and drifted (issue 31,
+ *     three low phases of the drive cycle: element C's 120 degC node at 1.25
+ *     against a truth of 1.015, its 80 degC node at 1.07);
  *         c_i += adapt_confidence_gain q_i (1 - c_i)   (confidence, 0..1).
  *   - kiss point: least squares of the residual r = T_imp - T_model on
  *     x1 = the model's Coulomb torque and x2 = its Coulomb torque per newton

@@ -92,8 +92,10 @@ typedef struct {
      * point) by the fraction whose open drag is the request; 0 or less: all
      * the way, the spring's preload. An off-going element released under
      * control needs it: at its kiss point a dragging pack may carry all of a
-     * light load. false (zero-initialized): no request goes below the kiss
-     * point. Without an open drag calibrated it changes nothing. */
+     * light load. Never above the learned kiss point (an earlier one would
+     * apply the pack). false (zero-initialized): the inverse's floor is the
+     * kiss point (the lead may still command below it for a period). Without
+     * an open drag calibrated it changes nothing. */
     bool band_release;
 } wc_step_input_t;
 

@@ -219,23 +219,25 @@ wc_adapt_change_t wc_adapt_finish(wc_adapt_t *adapt, const wc_shift_calibration_
         }
         const float band = cal->adapt_scale_band;
         /* each node's own step, normalised: the interpolated scale at the window's temperatures moves by
-         * gain * its error; a confident node moves at most half a step (one faulty shift costs it less) */
+         * gain * its error; a confident node's own step is at most half a step (one faulty shift costs it less) */
         float own_step[WC_ADAPT_NODES];
-        float window_step = 0.0f;  /* what the own steps move the window's interpolated scale by */
+        float window_scale = 0.0f;  /* the window's interpolated scale after the own steps */
         for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
             const float own = (share_sq > 0.0f) ? (share[i] / share_sq) : 0.0f;
             const float limit = cal->adapt_scale_step * (1.0f - 0.5f * v->confidence[i]);
             own_step[i] = clip(cal->adapt_scale_gain * own * v->friction_scale[i] * (rho - 1.0f), -limit, limit);
-            window_step += share[i] * own_step[i];
+            window_scale += share[i] * (v->friction_scale[i] + own_step[i]);
         }
         for (uint32_t i = 0u; i < WC_ADAPT_NODES; ++i) {
-            /* a node not yet learned (confidence 0) follows the window's scale, a smooth prior (neighbouring
-             * temperatures have similar scales until shifts there say otherwise): it moves with what the
-             * learned nodes learn, so its sum over the shifts is their net change, not a sum of every shift's
-             * error (which a node outside the windows, with no feedback of its own, would drift on) */
+            /* a node not yet learned (confidence 0) takes the window's scale, a smooth prior (neighbouring
+             * temperatures have similar scales until shifts there say otherwise): the level the learned nodes
+             * hold, not a sum of every shift's error (which a node outside the windows, with no feedback of
+             * its own, would drift on); at most a step per shift */
             const float c = v->confidence[i];
-            const float step = (c * own_step[i]) + ((1.0f - c) * window_step);
-            v->friction_scale[i] = clip(v->friction_scale[i] + step, 1.0f - band, 1.0f + band);
+            const float s = v->friction_scale[i];
+            const float step = clip((c * own_step[i]) + ((1.0f - c) * (window_scale - s)), -cal->adapt_scale_step,
+                                    cal->adapt_scale_step);
+            v->friction_scale[i] = clip(s + step, 1.0f - band, 1.0f + band);
             v->confidence[i] = clip(c + cal->adapt_confidence_gain * share[i] * (1.0f - c), 0.0f, 1.0f);
         }
         /* kiss point: the force offset the residual shows */

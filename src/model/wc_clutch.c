@@ -165,7 +165,7 @@ static float band_fraction(const wc_calibration_t *cal, const wc_torque_point_t 
     if (!(excess_m > 0.0f)) { return 0.0f; }
     const float a = (cal->open_aeration_speed_rad_s > 0.0f) ? (slip_rad_s / cal->open_aeration_speed_rad_s) : 0.0f;
     const float c_m = cal->open_clearance_m;
-    const float b_m = c_m + hbar_m * a * a;  /* > 0: h_bar > 0, and an open drag calibrated */
+    const float b_m = c_m + hbar_m * a * a;  /* 0 only with no clearance at zero slip, where T_v0 = 0 returned above */
     const float r = 2.0f * excess_m / (b_m + sqrtf(b_m * b_m + 4.0f * c_m * a * a * excess_m));
     return (r > 0.0f) ? ((r < 1.0f) ? r : 1.0f) : 0.0f;
 }
@@ -266,13 +266,16 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
     const bool open_drag = (model->cal->open_clearance_m > 0.0f) || (model->cal->open_aeration_speed_rad_s > 0.0f);
     if (in->band_release && open_drag && (in->mode == WC_MODE_TORQUE) && !clutch->lockup.locked && !(inv.force_N > 0.0f)) {
-        /* DESIGN 15: below the kiss point's drag, into the spring's band (before the learned kiss offset, as
-         * the forward model's retracted fraction) */
+        /* DESIGN 15: below the kiss point's drag, into the spring's band (the fraction before the learned
+         * kiss offset, as the forward model's retracted fraction) */
         const wc_calibration_t *c = model->cal;
         const float gap_hbar_m = film ? hbar_m : wc_film_hbar_near_m(&c->film, 0.0f, WC_FILM_NO_SEGMENT);
         const float contact_Nm = film ? (point.coulomb_Nm_per_N * c->friction_area_m2 * contact.pressure_Pa) : 0.0f;
         const float r = band_fraction(c, &point, u->torque_request_Nm - contact_Nm, gap_hbar_m, u->slip_rad_s);
-        inv.pressure_Pa = c->return_spring_force_N * (1.0f - r * (1.0f - WC_SPRING_PRELOAD_FRACTION)) / c->piston_area_m2;
+        const float band_Pa = c->return_spring_force_N * (1.0f - r * (1.0f - WC_SPRING_PRELOAD_FRACTION)) / c->piston_area_m2;
+        /* never above the learned kiss point (an earlier one, offset < 0, would apply the pack in the band) */
+        const float kiss_Pa = kiss_pressure_Pa(c, 0.0f, correction.kiss_offset_N);
+        inv.pressure_Pa = (band_Pa < kiss_Pa) ? band_Pa : kiss_Pa;
         status |= wc_vfs_current_mA(c, inv.pressure_Pa, &inv.current_mA);
     }
     const wc_lag_compensation_t *lag = &in->lag_compensation;

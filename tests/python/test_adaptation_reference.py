@@ -121,31 +121,40 @@ def test_learned_values_stay_in_their_bands_and_steps(table1):
     assert runs[-1]["after"].friction_scale[3] == 1.0 + SETTINGS.scale_band   # node 3 (130 degC): the band
 
 
-def _window_at_node(ref, node: int, rho: float):
-    """A valid shift's window all at one node whose measured torque ratio is rho (no kiss point, no film)."""
+def _window(ref, weights, rho: float):
+    """A valid shift's window with these node weights whose measured torque ratio is rho (no kiss point, no
+    film)."""
     ref.begin()
     w = ref.window
     w.started, w.samples, w.slip_start, w.slip_prev = True, 100, 100.0, 10.0
     w.sum_model, w.sum_implied = 1000.0, 1000.0 * rho
-    w.weight = [1000.0 if i == node else 0.0 for i in range(A.NODES)]
+    w.weight = [1000.0 * x for x in weights]
 
 
-def test_a_node_outside_every_window_follows_the_learned_one_and_does_not_sum_the_errors(table1):
-    """Issue 31: 60 shifts at the 80 degC node, truth 1.05, each measured with 4 % noise (seeded): the node
-    settles near its truth, and a node no shift reaches (40 degC, never learned) follows it, not the sum of
-    the 60 errors (a node that took each shift's error itself had no feedback through rho and drifted: in
-    three low phases of the drive cycle element C's 120 degC node reached 1.25 against a truth of 1.015). The tolerances: the 80 degC node's own noise after settling (gain x
-    4 % x the confidence's half step) is about 0.01; the follower differs from it only by the steps the
-    learned node took before it was confident (clipped differently); the old rule's follower ended 0.040 away."""
+def test_a_node_outside_every_window_takes_the_learned_level_and_does_not_sum_the_errors(table1):
+    """Issue 31: 300 shifts between the 70 and 100 degC nodes (nodes 1, 2; a random share each shift), truth
+    1.05, each measured with 4 % noise (seeded): node 4 (160 degC) is in no window and never learned. It takes
+    the window's learned scale (the level), so from the 30th shift on it stays within the range of the two learned
+    nodes (1e-9: the level is their convex combination), and over the last 100 shifts it averages within 0.03 of
+    the truth (the learned nodes' own average is 0.017 off with this seed: gain 0.6 x 4 % noise). A node that took
+    each shift's error, or each shift's change of the window's scale, had no feedback through rho and summed the
+    noise: on the same shifts 0.144 and 0.050 from the learned nodes, its average 0.090 and 0.019 off (three low
+    phases of the drive cycle under the first rule: element C's 120 degC node at 1.25 against a truth of 1.015)."""
     ref = A.AdaptationReference(SETTINGS, table1.period, table1.piston_area, film_on=False)
     rng = np.random.default_rng(7)
-    for _ in range(60):
-        rho = 1.05 / ref.values.friction_scale[1] * (1.0 + 0.04 * rng.standard_normal())
-        _window_at_node(ref, 1, rho)
+    last = []
+    for k in range(300):
+        share = rng.uniform(0.1, 0.9)
+        scale = share * ref.values.friction_scale[1] + (1.0 - share) * ref.values.friction_scale[2]
+        _window(ref, [0.0, share, 1.0 - share, 0.0, 0.0], 1.05 / scale * (1.0 + 0.04 * rng.standard_normal()))
         assert ref.finish(0)["result"] == A.RESULT_UPDATED
-    s = ref.values.friction_scale
-    assert abs(s[1] - 1.05) < 0.03
-    assert ref.values.confidence[0] == 0.0 and abs(s[0] - s[1]) < 0.01
+        s = ref.values.friction_scale
+        if k >= 30:
+            assert min(s[1], s[2]) - 1e-9 <= s[4] <= max(s[1], s[2]) + 1e-9, (k, s)
+        if k >= 200:
+            last.append(s[4])
+    assert abs(sum(last) / len(last) - 1.05) < 0.03
+    assert ref.values.confidence[4] == 0.0
 
 
 @pytest.mark.parametrize("name, result", [("implausible", A.RESULT_IMPLAUSIBLE), ("excitation", A.RESULT_EXCITATION),

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..calibration import Calibration
 from ..reference import evaluate as reference, model
+from ..reference.model.correction import Correction
 from ..util import atomic
 from . import adapt_vectors
 from .lut import banner
@@ -102,6 +103,12 @@ BAND_SLIPS_RPM = (400.0, 1500.0)
 BAND_REQUESTS_NM = (0.0, 0.5, 2.0, 5.0, 150.0, 1.0, 0.2)     # 60 ms each, at each slip
 
 
+# The band with the film state on, the lead and a learned correction (an earlier kiss point): the film's contact
+# torque, lead_lag after the band and the cap at the learned kiss pressure are compared too.
+BAND_LEAD_TIME_S = 0.015
+BAND_CORRECTION = Correction(friction_scale_delta=0.05, film_factor_delta=0.0, kiss_offset_N=-50.0)
+
+
 def band_profile(cal: Calibration):
     """The release into the spring's band (DESIGN 15; band_release on every step) in 0.84 s: torque control at
     each slip of BAND_SLIPS_RPM (0.42 s each) through the requests of BAND_REQUESTS_NM (60 ms each): from the
@@ -176,6 +183,12 @@ def header_text(cal: Calibration, command: str) -> str:
     bout = model.clutch_steps(open_cal, bin_["slip_rpm"], bin_["theta_oil_degC"], bin_["theta_housing_degC"],
                               bin_["torque_request_Nm"], mode=bin_["mode"], theta_start_degC=60.0, band_release=True)
     band = {**bin_, **bout, "open": np.array([model.retracted_fraction(cal, p) for p in bout["pressure_model_Pa"]])}
+    film_band_cal = open_cal.with_values(film_squeeze_factor=EDGES_SQUEEZE_FACTOR)
+    fout = model.clutch_steps(film_band_cal, bin_["slip_rpm"], bin_["theta_oil_degC"], bin_["theta_housing_degC"],
+                              bin_["torque_request_Nm"], mode=bin_["mode"], theta_start_degC=60.0, band_release=True,
+                              lag_compensation_time_s=BAND_LEAD_TIME_S, correction=BAND_CORRECTION)
+    film_band = {**bin_, **fout,
+                 "open": np.array([model.retracted_fraction(cal, p) for p in fout["pressure_model_Pa"]])}
     return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
@@ -223,6 +236,12 @@ def header_text(cal: Calibration, command: str) -> str:
         " * calibration above (DESIGN 15: a request below the kiss point's drag retracts the piston into its\n"
         " * spring's band; open: how far, from the modelled pressure). Every step. */\n"
         + _table("wc_golden_band", "wc_golden_band_t", band,
+                 ("step", "slip_rpm", "torque_request_Nm", "current_mA", "pressure_model_Pa", "open", "torque_Nm",
+                  "status"))
+        + f"\n/* The same with film_squeeze_factor = {EDGES_SQUEEZE_FACTOR}, lag compensation {BAND_LEAD_TIME_S} s and the"
+        f" correction\n * (friction +{BAND_CORRECTION.friction_scale_delta}, kiss offset {BAND_CORRECTION.kiss_offset_N} N:"
+        " an earlier kiss point, the band capped at it). */\n"
+        + _table("wc_golden_band_film", "wc_golden_band_t", film_band,
                  ("step", "slip_rpm", "torque_request_Nm", "current_mA", "pressure_model_Pa", "open", "torque_Nm",
                   "status"))
         + adapt_vectors.header_part(cal)

@@ -13,8 +13,9 @@ The measurement (DESIGN 10, 12): in the inertia phase
 paired with the model torque of period j-1. The update at the shift's end (finish): rho = sum T_imp /
 sum T_model, each node's share q_i of sum w_i(theta) T_model, normalised by Q = sum q_j^2 so that the
 interpolated scale at the window's temperatures moves by the gain times its error: each node's own step
-a_i = clip(gain (q_i / Q) s_i (rho - 1), +-step (1 - c_i / 2)), the window's step A = sum q_j a_j, and
-s_i += c_i a_i + (1 - c_i) A in its band (a node not yet learned follows the window's scale); the confidence c_i += gain_c q_i (1 - c_i) (c_i before the update); the kiss point from the least squares of
+a_i = clip(gain (q_i / Q) s_i (rho - 1), +-step (1 - c_i / 2)), the window's scale after them
+L = sum q_j (s_j + a_j), and s_i += clip(c_i a_i + (1 - c_i) (L - s_i), +-step) in its band (a node not yet
+learned takes the window's scale); the confidence c_i += gain_c q_i (1 - c_i) (c_i before the update); the kiss point from the least squares of
 r = T_imp - T_model on the model's Coulomb torque x1 and its Coulomb torque per newton x2; the film factor
 from the early window's ratio rho_e against rho.
 
@@ -277,11 +278,11 @@ class AdaptationReference:
             for i in range(NODES):
                 limit = st.scale_step * (1.0 - 0.5 * v.confidence[i])     # a confident node moves less per shift
                 own.append(_clip(st.scale_gain * share[i] / q2 * v.friction_scale[i] * (rho - 1.0), -limit, limit))
-            window_step = sum(q * a for q, a in zip(share, own))        # the window's interpolated scale's move
+            level = sum(q * (s + a) for q, s, a in zip(share, v.friction_scale, own))   # the window's scale after
             for i in range(NODES):
-                c = v.confidence[i]
-                v.friction_scale[i] = _clip(v.friction_scale[i] + c * own[i] + (1.0 - c) * window_step,
-                                            1.0 - band, 1.0 + band)
+                c, s = v.confidence[i], v.friction_scale[i]
+                step = _clip(c * own[i] + (1.0 - c) * (level - s), -st.scale_step, st.scale_step)
+                v.friction_scale[i] = _clip(s + step, 1.0 - band, 1.0 + band)
                 v.confidence[i] += st.confidence_gain * share[i] * (1.0 - c)
             # the kiss point: r = b1 x1 + b2 x2, b1 = s - 1, b2 = -s dF
             prod = w.s11 * w.s22

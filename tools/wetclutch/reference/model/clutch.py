@@ -124,7 +124,9 @@ class ClutchReference:
                                    friction_factor=corr.friction_factor)
             r = band_fraction(cal, request_Nm - abs(float(at_film["coulomb_Nm"])),
                               abs(float(at_film["viscous_Nm"])) * hbar, hbar, slip_rpm)
-            current = band_pressure_Pa(cal, r) / cal.vfs_gain
+            # never above the learned kiss point (an earlier one would apply the pack in the band)
+            kiss = max(cal.return_spring_force + corr.kiss_offset_N, 0.0) / cal.piston_area
+            current = min(band_pressure_Pa(cal, r), kiss) / cal.vfs_gain
             if current > cal.vfs_current_max:
                 current, status = cal.vfs_current_max, status | STATUS_CURRENT_CLAMPED
             elif current < cal.vfs_current_min:
@@ -194,11 +196,13 @@ class ClutchReference:
 
 
 def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC, torque_request_Nm,
-                 mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None, band_release=False):
+                 mode=None, theta_start_degC=None, bench_force_N=None, bench_torque_Nm=None, band_release=False,
+                 lag_compensation_time_s=0.0, correction=None):
     """The firmware's wc_clutch_step, composed in double precision, one row per period (ClutchReference).
     Returns a dict of arrays; theta_degC[k] is the estimate used in step k (before its update). On a bench
     (rows where bench_force_N / bench_torque_Nm are given and not NaN) the torque model uses the measured force
-    and the observer's heat input the measured torque. band_release: every step's (ClutchReference.step)."""
+    and the observer's heat input the measured torque. band_release, lag_compensation_time_s, correction: every
+    step's (ClutchReference.step)."""
     slip = np.asarray(slip_rpm, dtype=float)
     n = slip.size
     oil = np.broadcast_to(np.asarray(theta_oil_degC, dtype=float), (n,))
@@ -212,7 +216,8 @@ def clutch_steps(cal: Calibration, slip_rpm, theta_oil_degC, theta_housing_degC,
     out = {k: np.empty(n) for k in CLUTCH_OUTPUTS}
     for k in range(n):
         row = ref.step(float(slip[k]), float(oil[k]), float(housing[k]), float(request[k]), int(modes[k]),
-                       float(measured[k]), float(measured_torque[k]), band_release=bool(band_release))
+                       float(measured[k]), float(measured_torque[k]), band_release=bool(band_release),
+                       lag_compensation_time_s=float(lag_compensation_time_s), correction=correction)
         for key in CLUTCH_OUTPUTS:
             out[key][k] = row[key]
     out["status"] = out["status"].astype(int)
