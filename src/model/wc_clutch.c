@@ -136,6 +136,12 @@ static inline float retracted_fraction(const wc_calibration_t *cal, float pressu
     return (r > 0.0f) ? ((r < 1.0f) ? r : 1.0f) : ((r <= 0.0f) ? 0.0f : 1.0f);  /* NaN: retracted */
 }
 
+/* retracted_fraction's inverse: the pressure that stands the piston off the pack by the fraction r */
+static inline float band_pressure_Pa(const wc_calibration_t *cal, float retracted)
+{
+    return cal->return_spring_force_N * (1.0f - retracted * (1.0f - WC_SPRING_PRELOAD_FRACTION)) / cal->piston_area_m2;
+}
+
 static inline float open_gap_m(const wc_calibration_t *cal, float hbar_m, float retracted, float slip_rad_s)
 {
     float gap_m = hbar_m;
@@ -168,6 +174,23 @@ static float band_fraction(const wc_calibration_t *cal, const wc_torque_point_t 
     const float b_m = c_m + hbar_m * a * a;  /* 0 only with no clearance at zero slip, where T_v0 = 0 returned above */
     const float r = 2.0f * excess_m / (b_m + sqrtf(b_m * b_m + 4.0f * c_m * a * a * excess_m));
     return (r > 0.0f) ? ((r < 1.0f) ? r : 1.0f) : 0.0f;
+}
+
+/* DESIGN 15: a request below the kiss point's drag, into the spring's band: the fraction (before the learned
+ * kiss offset, as the forward model's retracted fraction) whose drag is the request less the film's contact
+ * torque; film: the film state hbar_m (else the steady film at zero force). Never above the learned
+ * kiss point (an earlier one, offset < 0, would apply the pack in the band). */
+static wc_status_t release_into_band(const wc_calibration_t *c, const wc_torque_point_t *point, bool film,
+                                     float film_hbar_m, float contact_Pa, const wc_held_inputs_t *u,
+                                     float kiss_offset_N, wc_inverse_t *inv)
+{
+    const float hbar_m = film ? film_hbar_m : wc_film_hbar_near_m(&c->film, 0.0f, WC_FILM_NO_SEGMENT);
+    const float contact_Nm = film ? (point->coulomb_Nm_per_N * c->friction_area_m2 * contact_Pa) : 0.0f;
+    const float band_Pa = band_pressure_Pa(c, band_fraction(c, point, u->torque_request_Nm - contact_Nm, hbar_m,
+                                                            u->slip_rad_s));
+    const float kiss_Pa = kiss_pressure_Pa(c, 0.0f, kiss_offset_N);
+    inv->pressure_Pa = (band_Pa < kiss_Pa) ? band_Pa : kiss_Pa;
+    return wc_vfs_current_mA(c, inv->pressure_Pa, &inv->current_mA);
 }
 
 /* x != 0 without a float equality (-Wfloat-equal); false for NaN. */
@@ -264,19 +287,12 @@ wc_status_t wc_clutch_step(wc_clutch_t *clutch, const wc_step_input_t *in, wc_st
     const float hbar_m = clutch->film_hbar_m;
     wc_film_contact_t contact = { 0.0f, 0.0f };
     if (film) { contact = wc_film_contact(&model->cal->film, hbar_m); }
+    /* (from the calibration each step: a flag in wc_model_t would take the clutch past its 64 B) */
     const bool open_drag = (model->cal->open_clearance_m > 0.0f) || (model->cal->open_aeration_speed_rad_s > 0.0f);
-    if (in->band_release && open_drag && (in->mode == WC_MODE_TORQUE) && !clutch->lockup.locked && !(inv.force_N > 0.0f)) {
-        /* DESIGN 15: below the kiss point's drag, into the spring's band (the fraction before the learned
-         * kiss offset, as the forward model's retracted fraction) */
-        const wc_calibration_t *c = model->cal;
-        const float gap_hbar_m = film ? hbar_m : wc_film_hbar_near_m(&c->film, 0.0f, WC_FILM_NO_SEGMENT);
-        const float contact_Nm = film ? (point.coulomb_Nm_per_N * c->friction_area_m2 * contact.pressure_Pa) : 0.0f;
-        const float r = band_fraction(c, &point, u->torque_request_Nm - contact_Nm, gap_hbar_m, u->slip_rad_s);
-        const float band_Pa = c->return_spring_force_N * (1.0f - r * (1.0f - WC_SPRING_PRELOAD_FRACTION)) / c->piston_area_m2;
-        /* never above the learned kiss point (an earlier one, offset < 0, would apply the pack in the band) */
-        const float kiss_Pa = kiss_pressure_Pa(c, 0.0f, correction.kiss_offset_N);
-        inv.pressure_Pa = (band_Pa < kiss_Pa) ? band_Pa : kiss_Pa;
-        status |= wc_vfs_current_mA(c, inv.pressure_Pa, &inv.current_mA);
+    if (in->band_release && open_drag && (in->mode == WC_MODE_TORQUE) && !clutch->lockup.locked &&
+        !(inv.force_N > 0.0f)) {
+        status |= release_into_band(model->cal, &point, film, hbar_m, contact.pressure_Pa, u, correction.kiss_offset_N,
+                                    &inv);
     }
     const wc_lag_compensation_t *lag = &in->lag_compensation;
     const bool lead = (in->mode == WC_MODE_TORQUE) && lag_time_valid(lag->time_s) && (lag->vfs_gain > 0.0f) &&

@@ -101,8 +101,6 @@ def open_drag_profile(cal: Calibration):
 
 BAND_SLIPS_RPM = (400.0, 1500.0)
 BAND_REQUESTS_NM = (0.0, 0.5, 2.0, 5.0, 150.0, 1.0, 0.2)     # 60 ms each, at each slip
-
-
 # The band with the film state on, the lead and a learned correction (an earlier kiss point): the film's contact
 # torque, lead_lag after the band and the cap at the learned kiss pressure are compared too.
 BAND_LEAD_TIME_S = 0.015
@@ -123,6 +121,14 @@ def band_profile(cal: Calibration):
             "theta_oil_degC": np.full(n, 60.0), "theta_housing_degC": np.full(n, 60.0),
             "torque_request_Nm": np.asarray(BAND_REQUESTS_NM)[level % per_slip],
             "mode": np.full(n, model.MODE_TORQUE)}
+
+
+def _steps_with_open(cal: Calibration, profile: dict, theta_start_degC: float, **step_options) -> dict:
+    """A profile's clutch_steps on cal, with the column open: how far the modelled piston stands off the pack."""
+    out = model.clutch_steps(cal, profile["slip_rpm"], profile["theta_oil_degC"], profile["theta_housing_degC"],
+                             profile["torque_request_Nm"], mode=profile["mode"], theta_start_degC=theta_start_degC,
+                             **step_options)
+    return {**profile, **out, "open": np.array([model.retracted_fraction(cal, p) for p in out["pressure_model_Pa"]])}
 
 
 def _c_double(x: float) -> str:
@@ -173,22 +179,15 @@ def header_text(cal: Calibration, command: str) -> str:
     edges = {**ein, **eout, "hbar_um": eout["hbar_m"] * 1e6}
     open_cal = cal.with_values(open_clearance=OPEN_CLEARANCE_M, open_aeration_speed=OPEN_AERATION_SPEED_RAD_S)
     oin = open_drag_profile(open_cal)
-    oout = model.clutch_steps(open_cal, oin["slip_rpm"], oin["theta_oil_degC"], oin["theta_housing_degC"],
-                              oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
     film = model.clutch_steps(cal, oin["slip_rpm"], oin["theta_oil_degC"], oin["theta_housing_degC"],
                               oin["torque_request_Nm"], mode=oin["mode"], theta_start_degC=60.0)
-    drag = {**oin, **oout, "open": np.array([model.retracted_fraction(cal, p) for p in oout["pressure_model_Pa"]]),
-            "film_torque_Nm": film["torque_Nm"], "film_theta_degC": film["theta_degC"]}
+    drag = {**_steps_with_open(open_cal, oin, 60.0), "film_torque_Nm": film["torque_Nm"],
+            "film_theta_degC": film["theta_degC"]}
     bin_ = band_profile(open_cal)
-    bout = model.clutch_steps(open_cal, bin_["slip_rpm"], bin_["theta_oil_degC"], bin_["theta_housing_degC"],
-                              bin_["torque_request_Nm"], mode=bin_["mode"], theta_start_degC=60.0, band_release=True)
-    band = {**bin_, **bout, "open": np.array([model.retracted_fraction(cal, p) for p in bout["pressure_model_Pa"]])}
-    film_band_cal = open_cal.with_values(film_squeeze_factor=EDGES_SQUEEZE_FACTOR)
-    fout = model.clutch_steps(film_band_cal, bin_["slip_rpm"], bin_["theta_oil_degC"], bin_["theta_housing_degC"],
-                              bin_["torque_request_Nm"], mode=bin_["mode"], theta_start_degC=60.0, band_release=True,
-                              lag_compensation_time_s=BAND_LEAD_TIME_S, correction=BAND_CORRECTION)
-    film_band = {**bin_, **fout,
-                 "open": np.array([model.retracted_fraction(cal, p) for p in fout["pressure_model_Pa"]])}
+    band = _steps_with_open(open_cal, bin_, 60.0, band_release=True)
+    film_band = _steps_with_open(open_cal.with_values(film_squeeze_factor=EDGES_SQUEEZE_FACTOR), bin_, 60.0,
+                                 band_release=True, lag_compensation_time_s=BAND_LEAD_TIME_S,
+                                 correction=BAND_CORRECTION)
     return (
         banner(command)
         + f"/* Golden vectors from the double-precision reference (tools/wetclutch/reference/model),\n"
@@ -232,7 +231,7 @@ def header_text(cal: Calibration, command: str) -> str:
         + _table("wc_golden_open_drag", "wc_golden_open_drag_t", drag,
                  ("step", "slip_rpm", "torque_request_Nm", "mode", "open", "pressure_model_Pa", "torque_Nm",
                   "theta_degC", "film_torque_Nm", "film_theta_degC"))
-        + f"\n/* wc_clutch_step with band_release on the band series (vectors.band_profile), the open element's\n"
+        + "\n/* wc_clutch_step with band_release on the band series (vectors.band_profile), the open element's\n"
         " * calibration above (DESIGN 15: a request below the kiss point's drag retracts the piston into its\n"
         " * spring's band; open: how far, from the modelled pressure). Every step. */\n"
         + _table("wc_golden_band", "wc_golden_band_t", band,

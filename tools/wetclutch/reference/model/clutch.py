@@ -14,7 +14,7 @@ from .constants import (MODE_LOCKED, MODE_TORQUE, RAD_S_PER_RPM, STATUS_CURRENT_
 from .film import hbar_from_pressure_m
 from .friction import (band_fraction, band_pressure_Pa, force_max_N, retracted_fraction, static_capacity_Nm,
                        torque_parts)
-from .inverse import holding_inverse, inverse
+from .inverse import holding_inverse, inverse, kiss_pressure_Pa
 from .lockup import Lockup
 from .squeeze_film import film_advance_m, film_contact_pressure_Pa, film_damping_N_s_m2
 from .thermal import thermal_decay, thermal_steady_degC
@@ -26,6 +26,15 @@ if TYPE_CHECKING:   # annotations only: the model reads a calibration's attribut
 CLUTCH_OUTPUTS = ("current_mA", "pressure_command_Pa", "pressure_model_Pa", "force_command_N", "theta_degC",
                   "torque_Nm", "mu_f", "hbar_m", "contact_force_N", "static_capacity_Nm", "status")
 LEAD_TIME_MAX_S = 10.0   # WC_CAL_LIMIT_VFS_TIME_CONSTANT_MAX_s: a longer lag-compensation time counts as off
+
+
+def _solenoid_current(cal: Calibration, current_mA: float) -> tuple[float, int]:
+    """current_mA in the solenoid's range, and STATUS_CURRENT_CLAMPED if it was not (wc_vfs_current_mA)."""
+    if current_mA > cal.vfs_current_max:
+        return cal.vfs_current_max, STATUS_CURRENT_CLAMPED
+    if current_mA < cal.vfs_current_min:
+        return cal.vfs_current_min, STATUS_CURRENT_CLAMPED
+    return current_mA, 0
 
 
 class ClutchReference:
@@ -80,7 +89,7 @@ class ClutchReference:
         if not force > force_cmd:
             return current
         force = min(force, force_max_N(cal))
-        pressure = max(force + cal.return_spring_force + corr.kiss_offset_N, 0.0) / cal.piston_area
+        pressure = float(kiss_pressure_Pa(cal, force, corr.kiss_offset_N))
         return min(max(pressure / cal.vfs_gain, cal.vfs_current_min), cal.vfs_current_max)
 
     def _lead_lag(self, time_s: float, current: float) -> tuple[float, int]:
@@ -90,12 +99,7 @@ class ClutchReference:
             return current, 0
         wanted = cal.vfs_gain * current
         gain = (1.0 - math.exp(-cal.period / time_s)) / (1.0 - self.a_vfs)
-        led = (self.pressure + (wanted - self.pressure) * gain) / cal.vfs_gain
-        if led > cal.vfs_current_max:
-            return cal.vfs_current_max, STATUS_CURRENT_CLAMPED
-        if led < cal.vfs_current_min:
-            return cal.vfs_current_min, STATUS_CURRENT_CLAMPED
-        return led, 0
+        return _solenoid_current(cal, (self.pressure + (wanted - self.pressure) * gain) / cal.vfs_gain)
 
     def step(self, slip_rpm: float, oil_degC: float, housing_degC: float, request_Nm: float, mode: int,
              bench_force_N: float = math.nan, bench_torque_Nm: float = math.nan, lag_compensation_time_s: float = 0.0,
@@ -125,12 +129,9 @@ class ClutchReference:
             r = band_fraction(cal, request_Nm - abs(float(at_film["coulomb_Nm"])),
                               abs(float(at_film["viscous_Nm"])) * hbar, hbar, slip_rpm)
             # never above the learned kiss point (an earlier one would apply the pack in the band)
-            kiss = max(cal.return_spring_force + corr.kiss_offset_N, 0.0) / cal.piston_area
-            current = min(band_pressure_Pa(cal, r), kiss) / cal.vfs_gain
-            if current > cal.vfs_current_max:
-                current, status = cal.vfs_current_max, status | STATUS_CURRENT_CLAMPED
-            elif current < cal.vfs_current_min:
-                current, status = cal.vfs_current_min, status | STATUS_CURRENT_CLAMPED
+            kiss = float(kiss_pressure_Pa(cal, 0.0, corr.kiss_offset_N))
+            current, clamped = _solenoid_current(cal, min(band_pressure_Pa(cal, r), kiss) / cal.vfs_gain)
+            status |= clamped
         lead = mode == MODE_TORQUE and lag_compensation_time_s > 0.0
         if lead:
             current = self._lead_film(theta_model, lag_compensation_time_s, force_cmd, current, corr)

@@ -70,13 +70,18 @@ def inverse(cal: Calibration, slip_rpm, theta_degC, torque_Nm, friction_factor: 
     force = np.where(below, 0.0, np.where(above, f_max, force))
     status |= np.where(below, STATUS_BELOW_DRAG, 0)
     status |= np.where(above, STATUS_SATURATED, 0)
-    # F_app = P A_p - F_s; DESIGN 12: the kiss offset moves the spring's preload, the pressure at least 0
-    pressure = np.maximum(force + cal.return_spring_force + kiss_offset_N, 0.0) / cal.piston_area
+    pressure = kiss_pressure_Pa(cal, force, kiss_offset_N)
     current = pressure / cal.vfs_gain                                 # P = K i
     clamped = (current < cal.vfs_current_min) | (current > cal.vfs_current_max)
     current = np.clip(current, cal.vfs_current_min, cal.vfs_current_max)
     status |= np.where(clamped, STATUS_CURRENT_CLAMPED, 0)
     return {"force_N": force, "pressure_Pa": pressure, "current_mA": current, "status": status}
+
+
+def kiss_pressure_Pa(cal: Calibration, force_N, kiss_offset_N: float = 0.0):
+    """The piston pressure of a contact force (wc_clutch.c kiss_pressure_Pa): F_app = P A_p - F_s; DESIGN 12: the
+    kiss offset moves the spring's preload; the pressure at least 0."""
+    return np.maximum(force_N + cal.return_spring_force + kiss_offset_N, 0.0) / cal.piston_area
 
 
 def holding_inverse(cal: Calibration, theta_degC: float, torque_Nm: float, friction_factor: float = 1.0,
