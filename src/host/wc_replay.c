@@ -15,7 +15,7 @@
  * --element-image's (one per element, in element order; an image with its
  * clutch alone, shift off), or without them --calibration's for every
  * element. Holding in a gear: the need x --holding-margin (1.3) and at least
- * --holding-floor N m (10). Starts holding --start-gear (1).
+ * --holding-floor N m (30). Starts holding --start-gear (1).
  *
  * --calibration-image: the whole calibration (clutch, shift control, loop
  * timeouts and E2E) from an image file (wc_cal_image.h, `wetclutch

@@ -17,16 +17,16 @@ typedef struct {
     size_t element_images;
     double start_gear;                                     /* --start-gear N (1) */
     double holding_margin;                                 /* --holding-margin F (1.3) */
-    double holding_floor_Nm;                               /* --holding-floor NM (10) */
+    double holding_floor_Nm;                               /* --holding-floor NM (30) */
 } wc_tcu_gearbox_options_t;
 
-#define WC_TCU_GEARBOX_OPTIONS_DEFAULT { NULL, { NULL }, 0u, 1.0, 1.3, 10.0 }
+#define WC_TCU_GEARBOX_OPTIONS_DEFAULT { NULL, { NULL }, 0u, 1.0, 1.3, 30.0 }
 #define WC_TCU_GEARBOX_USAGE                                                                                 \
     "  --gearbox NAME (8hp)  the transmission: every element of this compiled-in gearbox (DESIGN 15); needs a\n" \
     "                        shift calibration with the coordinator (--shift NAME or an image with it)\n"       \
     "  --element-image FILE  one per element, in element order: its clutch (an image with shift off)\n"         \
     "  --start-gear N        the gear held at start (1)\n"                                                     \
-    "  --holding-margin F    in a gear: the holding need x F (1.3), --holding-floor NM at least (10)\n"
+    "  --holding-margin F    in a gear: the holding need x F (1.3), --holding-floor NM at least (30)\n"
 
 /* Take the transmission's option at argv[*i] (its value at argv[*i + 1]): 1 taken (*i past the value),
  * 0 not one of them, -1 a bad or missing value (one line on stderr). */

@@ -87,6 +87,17 @@ def test_part_load_downshift_releases_the_off_going_element_into_its_band():
     assert t8.missed({**q, "load": 0.25}) == []
 
 
+
+def test_cold_coast_downshift_ends_with_every_element_of_the_new_gear_locked():
+    """The 8->7 coast downshift at 20 degC: its on-coming element C carries 15.6 N m in 7th by the plant's truth,
+    of which T_t's share is 8.7 (the rest is the open elements' cold drag). Held at that share x 1.3 and at least
+    10 N m it slipped 0.6 rad/s for good (under the gear-slip watch at the turbine) while the TCU reported the
+    shift done, a slipping element counted locked; at least 30 N m (transmission8.HOLDING_FLOOR_NM) locks it."""
+    q = t8.run_shift("nominal", 8, 7, "power-off downshift", load=0.0, oil_degC=20.0)
+    print(q)
+    assert (q["type"], q["abort"], q["end_gear"]) == ("power-off downshift", 0, "7")
+    assert t8.missed({**q, "load": 0.0}) == []
+
 KICKDOWNS = [c for c in CASES if c[2] == "power-on downshift"]
 SLOW_KICKDOWN = pytest.mark.xfail(
     strict=True, reason="missed (2026-11-28): the 3->2 kickdown's turbine at the 2nd gear's speed 0.625 s after the "

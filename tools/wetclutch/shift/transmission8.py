@@ -57,7 +57,12 @@ from .scenarios import ROOT, SHIFT_TOML, ShiftError
 
 LIBRARY = ROOT / "build" / "host-release" / "src" / "host" / "libwc_transmission_host.so"
 ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
-HOLDING_MARGIN, HOLDING_FLOOR_NM = 1.3, 10.0
+# In a gear each closed element is held at its share of T_t x 1.3, and at least 30 N m: besides T_t's share it
+# carries the open elements' drag and the estimate's error, which at a coast's 15 N m are not small. At 10 N m a
+# coast downshift at 20 degC ended with the on-coming element slipping 0.6 rad/s for good (8->7: C carried 15.6 N m
+# of which the TCU counted 8.7; below the gear-slip watch's 0.52 rad/s at the turbine), 6 of the matrix's 702
+# shifts and 16 of its 64 not completed; 30 N m completes them and changes no other shift's targets
+HOLDING_MARGIN, HOLDING_FLOOR_NM = 1.3, 30.0
 # The commanded inertia time per type (ShiftCommand.TargetInertiaTime: the integrator's shift schedule): the
 # comfort shifts slower. A tip-out's push (the on-coming clutch pulls the turbine down against the vehicle) gives
 # a jerk of 1 / T^2: 14.9 m/s^3 at 0.5 s, 6.6 at 0.8, 4.7 at 1.2 (2->3, nominal); a coast downshift's is the

@@ -52,7 +52,7 @@ class FrameTransmission:
     """The frame loop with the transmission on the gearbox's element images and the shift image, in process."""
 
     def __init__(self, gearbox_path, gear: int, theta_start_degC: float, holding_margin: float = 1.3,
-                 holding_floor_Nm: float = 10.0, lib=None, record: bool = False):
+                 holding_floor_Nm: float = 30.0, lib=None, record: bool = False):
         self.lib = lib or _library()
         u, f = ctypes.c_uint32, ctypes.c_float
         self.lib.wc_host_tx_init_frames.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
