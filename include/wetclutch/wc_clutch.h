@@ -92,7 +92,9 @@ typedef struct {
      * point) by the fraction whose open drag is the request; 0 or less: all
      * the way, the spring's preload. An off-going element released under
      * control needs it: at its kiss point a dragging pack may carry all of a
-     * light load. Never above the learned kiss point (an earlier one would
+     * light load; so does the on-coming element of a power-on upshift in its
+     * torque and inertia phases, whose drag at a high slip or a light load
+     * exceeds the request. Never above the learned kiss point (an earlier one would
      * apply the pack). false (zero-initialized): the inverse's floor is the
      * kiss point (the lead may still command below it for a period). Without
      * an open drag calibrated it changes nothing. */
