@@ -133,7 +133,7 @@ typedef struct wc_shift_calibration {
     float handover_slip_rad_s;         /* off-going slip below -this: the on-coming holds the turbine (tie-up): release */
     uint32_t engine_intervention;      /* 1: request engine torque (DBC EngineTorqueRequest) */
     float engine_increase_max_Nm;      /* torque phase: increase <= this */
-    float engine_reduction_max_Nm;     /* inertia phase: reduction <= this */
+    float engine_reduction_max_Nm;     /* inertia phase: reduction <= this, and the engine not below its zero torque (T_t0) */
     float engine_fill_fraction;        /* torque phase: increase = fraction * (b1 - b) / b * T_t0 (the torque hole) */
     float engine_reduction_fraction;   /* inertia phase: reduction = fraction * I_t |dref/dt| / a (the inertia torque), <= 2 */
     float engine_recovery_time_s;      /* after the inertia phase what is left of the request ramps out in this time */
@@ -347,7 +347,8 @@ float wc_shift_feedforward_Nm(const wc_shift_calibration_t *cal, float turbine_t
  * aborts with WC_SHIFT_ABORT_INPUT_LOST). in holds the sensors (slip,
  * temperatures, bench); the controller writes the rest of the clutch input in
  * place (mode, torque request, carried torque, lag compensation, temperature
- * source: on return in is the input the clutch stepped with), steps the
+ * source, the adaptation's correction, band_release in the whole shift's torque
+ * and inertia phases: on return in is the input the clutch stepped with), steps the
  * clutch (wc_clutch_step) and updates the quality vector. Returns true when
  * the shift ended this step; *report then holds its quality vector.
  * out must hold the previous step's output (zero-initialised before the

@@ -417,8 +417,8 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
             /* DESIGN 15: in the torque and inertia phases of the whole shift the on-coming element may release
              * below its kiss point too: at a light load or a skip shift's slip its drag there exceeds the
              * request, and held there it stalled the inertia phase (8-speed 6->7 at 25 % load: lock-up failed) */
-            in->band_release = coord && ((shift->phase == (uint32_t)WC_SHIFT_TORQUE) ||
-                                         (shift->phase == (uint32_t)WC_SHIFT_INERTIA));
+            in->band_release = coord && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) &&
+                               ((shift->phase == (uint32_t)WC_SHIFT_TORQUE) || (shift->phase == (uint32_t)WC_SHIFT_INERTIA));
         }
     }
 }
@@ -456,9 +456,9 @@ static WC_NOINLINE void engine_request(wc_shift_t *shift, const wc_shift_calibra
         const float reduction_Nm = (inertia_Nm < cal->engine_reduction_max_Nm) ? inertia_Nm : cal->engine_reduction_max_Nm;
         delta_Nm = increase_Nm * (1.0f - s) - reduction_Nm;
         /* DESIGN 14: at most down to the engine's zero torque: at a light load the inertia torque exceeds T_t0
-         * (8-speed 6->7 at 25 %: 149 of 62 N m), the engine was driven into its drag and the on-coming element,
-         * asked for less than its drag at the kiss point, stalled the inertia phase (lock-up failed) */
-        if ((t0_Nm > 0.0f) && (delta_Nm < -t0_Nm)) { delta_Nm = -t0_Nm; }
+         * (8-speed 6->7 at 25 %: 149 of 62 N m), the engine was driven into its drag and the on-coming element's
+         * request fell below its drag at the kiss point: the inertia phase stalled (lock-up failed) */
+        if (delta_Nm < -t0_Nm) { delta_Nm = -t0_Nm; }  /* T_t0 >= 0: the command's check */
         shift->engine_from_Nm = delta_Nm;
         shift->recovery_periods = 0u;
     } else if ((phase == (uint32_t)WC_SHIFT_LOCKUP) || (phase == (uint32_t)WC_SHIFT_LOCKED)) {

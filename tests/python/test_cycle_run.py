@@ -68,7 +68,7 @@ def test_every_request_engages(low):
 
 @pytest.mark.xfail(strict=True, reason="missed (2026-11-29): 6 of 74 shifts of the low phase end in lock-up failed:"
                    " five coast downshifts (2->1, 3->2, 4->3; four with the engine still pulling, 5..31 N*m) flare"
-                   " 131..469 rpm, three of them on the open converter (the lock-up not yet closed again after the"
+                   " 130..449 rpm, three of them on the open converter (the lock-up not yet closed again after the"
                    " shift before: the TCU's reduced model has it closed); one 4->5 upshift at 8 N*m")
 def test_every_shift_completes(low):
     assert [q for q in low[3] if q["abort"] != 0] == []

@@ -87,7 +87,6 @@ def test_part_load_downshift_releases_the_off_going_element_into_its_band():
     assert t8.missed({**q, "load": 0.25}) == []
 
 
-
 def test_cold_coast_downshift_ends_with_every_element_of_the_new_gear_locked():
     """The 8->7 coast downshift at 20 degC: its on-coming element C carries 15.6 N m in 7th by the plant's truth,
     of which T_t's share is 8.7 (the rest is the open elements' cold drag). Held at that share x 1.3 and at least
@@ -104,11 +103,21 @@ def test_light_load_upshift_releases_the_on_coming_element_into_its_band():
     takes most of the turbine torque out) is below A's drag at its kiss point at 180-260 rad/s of slip. Held at
     the kiss point the slip stalled at 17 rad/s and the shift ended in lock-up failed (AbortReason 2); released
     into its spring's band (wc_step_input_t.band_release on the on-coming element, DESIGN 15) it completes."""
-    q = t8.run_shift("nominal", 6, 7, "power-on upshift", load=0.25, oil_degC=110.0)
+    from wetclutch.gearbox import description
+    tr = t8.trace_shift("nominal", 6, 7, "power-on upshift", load=0.25, oil_degC=110.0)
+    q = tr.quality
     print(q)
     assert (q["type"], q["abort"], q["end_gear"]) == ("power-on upshift", 0, "7")
     assert abs(q["inertia_time_s"] / q["target_s"] - 1.0) <= t8.INERTIA_TOLERANCE
-    assert q["excursion_rpm"] <= 30.0 and q["peak_jerk_m_s3"] <= LIMITS["power-on upshift"]
+    # (the tie-up is not asserted: the fill pulse's residual at the landing, the light-load upshifts' known miss)
+    assert q["excursion_rpm"] <= t8.EXCURSION_RPM and q["peak_jerk_m_s3"] <= LIMITS["power-on upshift"]
+    # released into the band: in the inertia phase A's current went below its kiss point's (F_s / A_p / K,
+    # 52.2 mA); 5 mA below it is a tenth of the band (the spring's 0.8..1 F_s: 41.7..52.2 mA), far from the noise
+    cal = next(e for e in description.read(t8.ROOT / "tools" / "gearboxes" / "8hp.toml").elements
+               if e.name == "A").calibration
+    kiss_mA = cal.return_spring_force / cal.piston_area / cal.vfs_gain
+    inertia = np.asarray(tr.tcu["phase"]) == t8.PHASES.index("inertia")
+    assert float(np.min(tr.tcu["A_current_mA"][inertia])) < kiss_mA - 5.0
 
 
 def test_light_load_upshift_takes_the_engine_no_lower_than_its_zero_torque():
@@ -123,6 +132,7 @@ def test_light_load_upshift_takes_the_engine_no_lower_than_its_zero_torque():
     # T_t0 is the TCU's estimate of the turbine torque at the request: the truth's x (1 + the nominal
     # vehicle's 3 % estimate bias), 5 % allowed for the bias and the torque's drift before the request
     assert float(np.min(tr.tcu["engine_delta_Nm"])) >= -1.05 * q["turbine_torque_Nm"]
+
 
 KICKDOWNS = [c for c in CASES if c[2] == "power-on downshift"]
 SLOW_KICKDOWN = pytest.mark.xfail(

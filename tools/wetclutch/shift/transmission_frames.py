@@ -23,7 +23,7 @@ from ..calibration import cal_image, shift as shift_calibration
 from ..util import canlog
 from .matrix8 import CONTROLLER, _element_clutch_values
 from .scenarios import SHIFT_TOML, ShiftError
-from .transmission8 import _library, _Step
+from .transmission8 import HOLDING_FLOOR_NM, HOLDING_MARGIN, _library, _Step
 
 ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
 GEARBOX = "8hp"                              # wc_replay --gearbox: the table libwc_transmission_host has
@@ -51,8 +51,8 @@ def shift_image(gearbox_path) -> bytes:
 class FrameTransmission:
     """The frame loop with the transmission on the gearbox's element images and the shift image, in process."""
 
-    def __init__(self, gearbox_path, gear: int, theta_start_degC: float, holding_margin: float = 1.3,
-                 holding_floor_Nm: float = 30.0, lib=None, record: bool = False):
+    def __init__(self, gearbox_path, gear: int, theta_start_degC: float, holding_margin: float = HOLDING_MARGIN,
+                 holding_floor_Nm: float = HOLDING_FLOOR_NM, lib=None, record: bool = False):
         self.lib = lib or _library()
         u, f = ctypes.c_uint32, ctypes.c_float
         self.lib.wc_host_tx_init_frames.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
