@@ -237,7 +237,8 @@ typedef struct {
 
 /* The phase's law; may change the phase (PREPARE -> INERTIA). */
 static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, float dt_s,
-                                 bool offgoing_saturated, bool oncoming_saturated, bool assist, bool engine)
+                                 bool offgoing_saturated, bool oncoming_saturated, bool assist, bool engine,
+                                 float oncoming_model_Nm)
 {
     requests_t r = { 0.0f, 0.0f, 0.0f, false, true };
     const float t_t_Nm = shift->turbine_torque_Nm;
@@ -366,7 +367,11 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
     const float past_rad_s = (past_signed_rad_s > 0.0f) ? past_signed_rad_s : 0.0f;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
         const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * past_rad_s * dt_s;
-        shift->flare_integral_Nm = (integral_Nm < fabsf(t_t_Nm)) ? integral_Nm : fabsf(t_t_Nm);  /* anti-windup: |T_t| */
+        /* anti-windup: |T_t| beyond what the clutch carries already. |T_t| alone: a cold coast downshift's
+         * on-coming element, whose drag at its kiss point was more than the integral could ask, slipped on at
+         * 9 rad/s after synchronism, carrying T_t by its drag, and failed to lock (8-speed 6->5 at 20 degC) */
+        const float limit_Nm = fabsf(t_t_Nm) + fabsf(oncoming_model_Nm);
+        shift->flare_integral_Nm = (integral_Nm < limit_Nm) ? integral_Nm : limit_Nm;
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
     }
     r.oncoming_Nm = hold_Nm * x + cal->flare_kp_Nm_per_rad_s * past_rad_s + shift->flare_integral_Nm;
@@ -455,7 +460,7 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     const bool oncoming_assist = (options & WC_SHIFT_INERTIA_FIRST_ASSIST) != 0u;
     const bool engine = (options & WC_SHIFT_INERTIA_FIRST_ENGINE) != 0u;
     const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated, oncoming_saturated,
-                                        oncoming_assist, engine);
+                                        oncoming_assist, engine, out->model.torque_Nm);
     /* the on-coming clutch: with the assist (the tip-out) at its kiss point from PREPARE, without the fill
      * pulse: the pulse's overshoot at the whole slip pushed the turbine down at the phase's start (on the 8HP's
      * 3->4 57 N m of the element's torque against the engine's drag of 22, the off-going element held back 66

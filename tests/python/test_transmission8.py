@@ -134,6 +134,17 @@ def test_light_load_upshift_takes_the_engine_no_lower_than_its_zero_torque():
     assert float(np.min(tr.tcu["engine_delta_Nm"])) >= -1.05 * q["turbine_torque_Nm"]
 
 
+def test_cold_coast_downshift_closes_the_slip_its_drag_holds_open():
+    """The 6->5 coast downshift at 20 degC: after synchronism the on-coming element B, at its kiss point, carried
+    the coast torque by its cold drag at 9 rad/s of slip, and the slip correction's integral, capped at |T_t|,
+    could never ask for more than that drag: lock-up failed (AbortReason 2). Capped at |T_t| beyond what the
+    element carries, it closes the slip."""
+    q = t8.run_shift("nominal", 6, 5, "power-off downshift", load=0.0, oil_degC=20.0)
+    print(q)
+    assert (q["type"], q["abort"], q["end_gear"]) == ("power-off downshift", 0, "5")
+    assert t8.missed({**q, "load": 0.0}) == []
+
+
 KICKDOWNS = [c for c in CASES if c[2] == "power-on downshift"]
 SLOW_KICKDOWN = pytest.mark.xfail(
     strict=True, reason="missed (2026-11-28): the 3->2 kickdown's turbine at the 2nd gear's speed 0.625 s after the "
