@@ -89,8 +89,8 @@ class ClutchReference:
         if not force > force_cmd:
             return current
         force = min(force, force_max_N(cal))
-        pressure = float(kiss_pressure_Pa(cal, force, corr.kiss_offset_N))
-        return min(max(pressure / cal.vfs_gain, cal.vfs_current_min), cal.vfs_current_max)
+        # the current clamped to the solenoid's range, no status (the firmware's lead_film drops it too)
+        return _solenoid_current(cal, float(kiss_pressure_Pa(cal, force, corr.kiss_offset_N)) / cal.vfs_gain)[0]
 
     def _lead_lag(self, time_s: float, current: float) -> tuple[float, int]:
         """DESIGN 9: K i = P + (P* - P) (1 - e^(-dt/t)) / (1 - e^(-dt/tau)), clamped (wc_clutch.c lead_lag)."""
