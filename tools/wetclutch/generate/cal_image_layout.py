@@ -143,26 +143,36 @@ def files() -> dict[Path, str]:
     return {HEADER: header_text(), SOURCE: source_text()}
 
 
-def write(root: Path) -> list[Path]:
-    """Both files under root, atomically (all or nothing)."""
+def write_generated(root: Path, generated: dict[Path, str]) -> list[Path]:
+    """Generated files (paths relative to root) under root, atomically (all or nothing)."""
     written = []
     with Staged() as out:
-        for rel, text in files().items():
+        for rel, text in generated.items():
             (root / rel).parent.mkdir(parents=True, exist_ok=True)
             out.write_text(root / rel, text)
             written.append(root / rel)
     return written
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog=COMMAND, description=__doc__,
+def write(root: Path) -> list[Path]:
+    """Both files under root, atomically (all or nothing)."""
+    return write_generated(root, files())
+
+
+def generator_main(command: str, doc: str, generated, argv: list[str] | None) -> int:
+    """A generator's command line: --out ROOT (this repository by default); prints what it wrote."""
+    parser = argparse.ArgumentParser(prog=command, description=doc,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", default=str(Path(__file__).resolve().parents[3]),
                         help="the repository root to write under (default: this repository)")
     args = parser.parse_args(argv)
-    for path in write(Path(args.out)):
+    for path in write_generated(Path(args.out), generated()):
         print(f"wrote {path}")
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    return generator_main(COMMAND, __doc__, files, argv)
 
 
 if __name__ == "__main__":
