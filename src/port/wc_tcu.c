@@ -216,7 +216,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"dtc-aging-cycles", required_argument, NULL, 14},
         {"gearbox", required_argument, NULL, 15},      {"element-image", required_argument, NULL, 15},
         {"start-gear", required_argument, NULL, 15},   {"holding-margin", required_argument, NULL, 15},
-        {"holding-floor", required_argument, NULL, 15},
+        {"holding-floor", required_argument, NULL, 15},  {"gearbox-image", required_argument, NULL, 15},
         {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
     *o = (options_t){.iface = "vcan0", .calibration = "table1", .period_ns = 0, .theta_start_degC = 40.0,
                      .sensor_timeout = 10u, .request_timeout = 10u, .security_delay_ms = 10000u, .dtc_aging_cycles = 40u,

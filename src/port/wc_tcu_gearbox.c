@@ -27,6 +27,9 @@ int wc_tcu_gearbox_option(const char *program, int argc, char **argv, int *i, wc
     if (strcmp(name, "--gearbox") == 0) {
         o->gearbox = value;
         taken = (value != NULL) ? 1 : -1;
+    } else if (strcmp(name, "--gearbox-image") == 0) {
+        o->gearbox_image = value;
+        taken = (value != NULL) ? 1 : -1;
     } else if (strcmp(name, "--element-image") == 0) {
         if ((value == NULL) || (o->element_images >= WC_GEARBOX_ELEMENTS_MAX)) {
             fprintf(stderr, "%s: --element-image: a file, at most %u\n", program, (unsigned)WC_GEARBOX_ELEMENTS_MAX);
@@ -59,15 +62,27 @@ int wc_tcu_gearbox_config(const char *program, const wc_tcu_gearbox_options_t *o
                           float theta_start_degC, wc_loop_config_t *config, wc_transmission_config_t *tx,
                           wc_cal_set_t images[WC_GEARBOX_ELEMENTS_MAX])
 {
-    if (o->gearbox == NULL) {
+    if ((o->gearbox == NULL) && (o->gearbox_image == NULL)) {
         if (o->element_images == 0u) { return 0; }
-        fprintf(stderr, "%s: --element-image needs --gearbox\n", program);
+        fprintf(stderr, "%s: --element-image needs --gearbox or --gearbox-image\n", program);
         return 2;
     }
-    const wc_gearbox_t *gearbox = wc_tcu_find_gearbox(o->gearbox);
-    if (gearbox == NULL) {
-        fprintf(stderr, "%s: --gearbox: '%s' is not compiled in (8hp)\n", program, o->gearbox);
+    if ((o->gearbox != NULL) && (o->gearbox_image != NULL)) {
+        fprintf(stderr, "%s: --gearbox and --gearbox-image: one gearbox, not both\n", program);
         return 2;
+    }
+    static wc_gearbox_t from_image;  /* --gearbox-image: the loop keeps a pointer to it for the program's life */
+    const char *name = (o->gearbox != NULL) ? o->gearbox : o->gearbox_image;
+    const wc_gearbox_t *gearbox = NULL;
+    if (o->gearbox != NULL) {
+        gearbox = wc_tcu_find_gearbox(o->gearbox);
+        if (gearbox == NULL) {
+            fprintf(stderr, "%s: --gearbox: '%s' is not compiled in (8hp)\n", program, o->gearbox);
+            return 2;
+        }
+    } else {
+        if (wc_gearbox_image_file_load(o->gearbox_image, program, &from_image) != 0) { return 2; }
+        gearbox = &from_image;
     }
     if ((config->shift == NULL) || (config->shift->coordinator != 1u)) {
         fprintf(stderr, "%s: --gearbox needs a shift calibration with the coordinator (the whole shift's):"
@@ -75,8 +90,8 @@ int wc_tcu_gearbox_config(const char *program, const wc_tcu_gearbox_options_t *o
         return 2;
     }
     if ((o->element_images != 0u) && (o->element_images != gearbox->element_count)) {
-        fprintf(stderr, "%s: --gearbox %s has %u elements: give --element-image for each, or none\n", program,
-                o->gearbox, (unsigned)gearbox->element_count);
+        fprintf(stderr, "%s: the gearbox %s has %u elements: give --element-image for each, or none\n", program,
+                name, (unsigned)gearbox->element_count);
         return 2;
     }
     memset(tx, 0, sizeof *tx);
@@ -93,8 +108,8 @@ int wc_tcu_gearbox_config(const char *program, const wc_tcu_gearbox_options_t *o
     static wc_transmission_t check;  /* wc_transmission_init says why it refuses; wc_loop_init only WC_CAL_NULL */
     const wc_transmission_error_t error = wc_transmission_init(&check, tx, (uint32_t)o->start_gear, theta_start_degC);
     if (error != WC_TRANSMISSION_OK) {
-        fprintf(stderr, "%s: --gearbox %s refused (wc_transmission_error_t %d: gearbox 2, element 3, shift 4,"
-                        " holding 5, start gear 6)\n", program, o->gearbox, (int)error);
+        fprintf(stderr, "%s: the gearbox %s refused (wc_transmission_error_t %d: gearbox 2, element 3, shift 4,"
+                        " holding 5, start gear 6)\n", program, name, (int)error);
         return 2;
     }
     config->transmission = tx;

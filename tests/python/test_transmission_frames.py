@@ -108,16 +108,32 @@ def test_the_frames_of_every_period(shifts, case):
     assert changes == [(source, target)]
 
 
+def _gearbox_image(tmp_path) -> str:
+    """`wetclutch gearbox` of the 8HP description with the nominal vehicle, as a gearbox image (issue 29 item 1)."""
+    import subprocess
+    import sys
+    image = tmp_path / "8hp.img"
+    subprocess.run([sys.executable, "-m", "wetclutch.cli", "gearbox", "tools/gearboxes/8hp.toml", "--vehicle",
+                    "tools/plants/vehicles/nominal.toml", "--out", str(tmp_path / "8hp_shifts.toml"), "--image",
+                    str(image)], cwd=transmission8.ROOT, check=True, capture_output=True,
+                   env={"PYTHONPATH": str(transmission8.ROOT / "tools"), "PATH": "/usr/bin:/bin"})
+    return str(image)
+
+
+@pytest.mark.parametrize("gearbox", ["compiled-in", "image"])
 @pytest.mark.parametrize("case", CASES[:2], ids=[f"{s}-{t}-{k.replace(' ', '_')}" for s, t, k in CASES[:2]])
-def test_wc_replay_answers_the_recorded_inputs_with_the_same_frames(shifts, case, tmp_path):
+def test_wc_replay_answers_the_recorded_inputs_with_the_same_frames(shifts, case, gearbox, tmp_path):
     """The program: wc_replay --gearbox (the same loop, src/host/wc_replay.c) given the closed loop's input
-    frames as a candump log answers with exactly the frames the in-process loop sent, period by period."""
+    frames as a candump log answers with exactly the frames the in-process loop sent, period by period; and
+    the same with --gearbox-image, the table as an image `wetclutch gearbox --image` wrote (the TCU runs a
+    gearbox it did not compile in with the same result)."""
     import subprocess
     from wetclutch.shift.transmission_frames import element_images, shift_image, write_inputs_log
     _, _, log = shifts[case]
     path = transmission8.plant_path("nominal")
     gearbox_path = transmission8._plant_and_models(str(path))[0].gearbox.path   # noqa: SLF001
-    args = ["--gearbox", "8hp", "--start-gear", str(case[0]), "--theta-start", "80"]
+    table = ["--gearbox", "8hp"] if gearbox == "compiled-in" else ["--gearbox-image", _gearbox_image(tmp_path)]
+    args = [*table, "--start-gear", str(case[0]), "--theta-start", "80"]
     for e, image in zip(ELEMENTS, element_images(gearbox_path)):
         (tmp_path / f"{e}.img").write_bytes(image)
         args += ["--element-image", str(tmp_path / f"{e}.img")]
@@ -146,15 +162,49 @@ BAD_GEARBOX_OPTIONS = [
 ]
 
 
+BAD_GEARBOX_IMAGES = [
+    ("missing", "No such file"),
+    ("both", "not both"),
+    ("element 256", "BAD_FIELD (gearbox.shift.oncoming)"),
+    ("truncated", "TRUNCATED"),
+]
+
+
+def _bad_gearbox_image(kind: str, tmp_path) -> list[str]:
+    """Options with a gearbox image that must be refused: none there, with --gearbox too, a shift's on-coming
+    element 256 + its own (sealed again: only the layout's rule refuses it), cut short."""
+    from wetclutch.calibration import gearbox_image
+    from wetclutch.util.image import write_image
+    whole = ["--shift", "shift_1_2_whole_full"]
+    if kind == "missing":
+        return ["--gearbox-image", str(tmp_path / "none.img"), *whole]
+    image = _gearbox_image(tmp_path)
+    if kind == "both":
+        return ["--gearbox", "8hp", "--gearbox-image", image, *whole]
+    data = open(image, "rb").read()
+    if kind == "truncated":
+        data = data[:-5]
+    else:
+        values = gearbox_image.read_image(data)
+        values["gearbox.shift.oncoming"][0] += 256
+        data = write_image(gearbox_image.MAGIC, gearbox_image.VERSION, gearbox_image.encode(values))
+    open(image, "wb").write(data)
+    return ["--gearbox-image", image, *whole]
+
+
 @pytest.mark.parametrize("program", ["wc_replay", "wc_tcu"])
-@pytest.mark.parametrize("args,says", BAD_GEARBOX_OPTIONS, ids=[s for _, s in BAD_GEARBOX_OPTIONS])
-def test_bad_gearbox_options_are_one_line_and_exit_2(program, args, says):
+@pytest.mark.parametrize("args,says", BAD_GEARBOX_OPTIONS + BAD_GEARBOX_IMAGES,
+                         ids=[s for _, s in BAD_GEARBOX_OPTIONS + BAD_GEARBOX_IMAGES])
+def test_bad_gearbox_options_are_one_line_and_exit_2(program, args, says, tmp_path):
     """The transmission's options, shared by wc_replay and wc_tcu (src/port/wc_tcu_gearbox.c): a refused one is
-    one line on stderr naming it and exit 2, before any frame or socket (wc_tcu refuses before SocketCAN)."""
+    one line on stderr naming it and exit 2, before any frame or socket (wc_tcu refuses before SocketCAN);
+    a refused gearbox image names its result and field."""
     import subprocess
     path = transmission8.ROOT / "build" / "host-release" / "src" / ("host" if program == "wc_replay" else "port") / program
     if not path.is_file():
         pytest.skip(f"{program} not built")
+    if isinstance(args, str):
+        args = _bad_gearbox_image(args, tmp_path)
     cmd = [str(path), *(["-"] if program == "wc_replay" else []), *args]
     res = subprocess.run(cmd, capture_output=True, text=True, stdin=subprocess.DEVNULL, timeout=30)
     assert res.returncode == 2, res.stderr

@@ -295,20 +295,26 @@ def _cmd_vehicle_cal(args) -> int:
 
 
 def _cmd_gearbox(args) -> int:
+    from .calibration import gearbox_image
     from .gearbox import table
     from .generate import gearbox_header
     argv = [args.gearbox] + (["--vehicle", args.vehicle] if args.vehicle else []) + (["--out", args.out] if args.out else [])
-    if args.header and not args.vehicle:   # before any work: the header carries the per-shift inertias
-        print("wetclutch gearbox: --header needs --vehicle (the reduced models' inertias)", file=sys.stderr)
-        return 2
+    for option, given in (("--header", args.header), ("--image", args.image)):
+        if given and not args.vehicle:   # before any work: the header and the image carry the per-shift inertias
+            print(f"wetclutch gearbox: {option} needs --vehicle (the reduced models' inertias)", file=sys.stderr)
+            return 2
     status = table.main(argv)
-    if status != 0 or not args.header:
+    if status != 0 or not (args.header or args.image):
         return status
     out = Path(args.out) if args.out else Path(args.gearbox).with_name(Path(args.gearbox).stem + "_shifts.toml")
-    command = "wetclutch gearbox " + " ".join(argv) + f" --header {args.header}"
     try:
-        print(gearbox_header.write_header(out, args.header, command))
-    except (gearbox_header.GearboxHeaderError, OSError) as e:
+        if args.header:
+            command = "wetclutch gearbox " + " ".join(argv) + f" --header {args.header}"
+            print(gearbox_header.write_header(out, args.header, command))
+        if args.image:
+            n = gearbox_image.write_file(args.image, out)
+            print(f"{args.image} ({n} bytes: the gearbox image, wc_gearbox_image.h; wc_tcu --gearbox-image)")
+    except (gearbox_header.GearboxHeaderError, gearbox_image.GearboxImageError, OSError) as e:
         print(f"wetclutch gearbox: {e}", file=sys.stderr)
         return 1
     return 0
@@ -486,6 +492,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", metavar="PATH", help="shift table to write (default <gearbox stem>_shifts.toml beside it)")
     q.add_argument("--header", metavar="PATH", help="also the firmware's C header of the table (wc_gearbox_t,"
                    " include/wetclutch/wc_gearbox.h), e.g. lut/wc_8hp_gearbox.h; needs --vehicle")
+    q.add_argument("--image", metavar="PATH", help="also the table as a gearbox image (wc_gearbox_image.h) for"
+                   " wc_tcu / wc_replay --gearbox-image PATH: a gearbox the TCU did not compile in; needs --vehicle")
     q.set_defaults(func=_cmd_gearbox)
     q = sub.add_parser("film-study", help="the squeeze-film state over a family of bench plants (issue 12):"
                                           " identified on two engagements, tested on 12 others per plant")
