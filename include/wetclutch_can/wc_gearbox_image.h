@@ -53,8 +53,10 @@ typedef struct {
     uint32_t error;    /* BAD_FIELD: the payload offset; BAD_GEARBOX: wc_gearbox_error_t; else 0 */
 } wc_gearbox_image_status_t;
 
-/* The payload's length in bytes (generated with the layout). */
+/* The payload's length in bytes (generated with the layout), at most
+ * WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES (static buffers; checked where generated). */
 extern const uint32_t wc_gearbox_image_payload_bytes;
+#define WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES 8192u
 
 /* Reads and checks a whole image (image: length bytes) into gearbox. On
  * anything but OK gearbox is zeroed and the status says why. */

@@ -58,7 +58,11 @@
  *       1 = the reference page (read only: the image the TCU started from);
  *   measurement at loop_base: the wc_loop_t (read only);
  *   slave status at status_base: wc_xcp_status_t (read only);
- *   identification at id_base: the GET_ID texts (read only).
+ *   identification at id_base: the GET_ID texts (read only);
+ *   gearbox at gearbox_base: the gearbox image's payload (wc_gearbox_image.h)
+ *       of the transmission the TCU runs (read only: a gearbox is flashed,
+ *       not tuned while it drives); wc_xcp_set_gearbox gives it, and
+ *       without one the region answers ERR_ACCESS_DENIED.
  * On a 64-bit host the bases are offsets the slave reports (wc_xcp_init's
  * config, printed by wc_tcu --xcp-layout); on a 32-bit target they may be
  * the objects' addresses. The A2L (tools/wetclutch/generate/a2l.py) takes
@@ -175,6 +179,7 @@ typedef struct {
     void *context;
     uint32_t unlock_attempts;     /* 1..255 wrong keys in a row until the lock-out (with the hooks) */
     uint32_t unlock_delay_steps;  /* the lock-out, 1..WC_XCP_UNLOCK_DELAY_MAX_STEPS control steps (with the hooks) */
+    uint32_t gearbox_base;
 } wc_xcp_config_t;
 
 #define WC_XCP_UNLOCK_DELAY_MAX_STEPS 0x7FFFFFFFu
@@ -183,7 +188,7 @@ typedef struct {
  * GET_SEED out for 10000 control steps (10 s at the 1 ms period), as UDS SecurityAccess's default (wc_uds.h). */
 #define WC_XCP_CONFIG_DEFAULT                                                                          \
     { 0x00010000u, 0x00100000u, 0x00200000u, 0x00300000u, "wetclutch TCU", "wetclutch", false, 6u, 6u, \
-      NULL, NULL, NULL, 3u, 10000u }
+      NULL, NULL, NULL, 3u, 10000u, 0x00400000u }
 
 /* What the master can read of the slave (UPLOAD, DAQ): the counters and the
  * last page check. */
@@ -225,6 +230,7 @@ typedef struct {
     wc_xcp_config_t config;
     wc_loop_t *loop;
     const uint8_t *reference_page;  /* the image's payload the TCU started from (flash) */
+    const uint8_t *gearbox_page;    /* the gearbox image's payload (flash); NULL: no gearbox region */
     uint8_t working_page[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
     wc_cal_set_t sets[2];           /* the decoded working page: the one the loop uses, the next */
     int32_t loop_set;               /* index of sets the loop uses; -1: the integrator's own */
@@ -277,9 +283,15 @@ bool wc_xcp_receive(wc_xcp_t *xcp, const wc_can_frame_t *frame);
  * out (responses first, then DAQ) and returns their count. */
 uint32_t wc_xcp_step(wc_xcp_t *xcp, bool control_step, wc_can_frame_t out[WC_XCP_TX_FRAMES]);
 
+/* The gearbox region's bytes: gearbox_payload (wc_gearbox_image_payload_bytes
+ * bytes, wc_gearbox_image.h: the payload of the gearbox image the
+ * transmission runs, or the compiled-in table's encoded once at start) must
+ * outlive the slave; NULL: the region answers ERR_ACCESS_DENIED again. */
+void wc_xcp_set_gearbox(wc_xcp_t *xcp, const uint8_t *gearbox_payload);
+
 /* The memory regions (for the A2L and wc_tcu --xcp-layout): index 0 cal,
- * 1 loop, 2 status, 3 id. */
-#define WC_XCP_REGIONS 4u
+ * 1 loop, 2 status, 3 id, 4 gearbox. */
+#define WC_XCP_REGIONS 5u
 void wc_xcp_regions(const wc_xcp_t *xcp, wc_xcp_region_t regions[WC_XCP_REGIONS]);
 
 #endif /* WC_XCP_H */

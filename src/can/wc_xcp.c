@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "wetclutch/wetclutch.h"
+#include "wetclutch_can/wc_gearbox_image.h"
 
 #define XCP_OK 0x100u               /* a handler's positive result (error codes are < 0x100) */
 #define MAX_CTO 8u
@@ -99,6 +100,13 @@ void wc_xcp_regions(const wc_xcp_t *xcp, wc_xcp_region_t regions[WC_XCP_REGIONS]
     regions[1] = (wc_xcp_region_t){ xcp->config.loop_base, (uint32_t)sizeof(wc_loop_t) };
     regions[2] = (wc_xcp_region_t){ xcp->config.status_base, (uint32_t)sizeof(wc_xcp_status_t) };
     regions[3] = (wc_xcp_region_t){ xcp->config.id_base, WC_XCP_ID_BYTES };
+    regions[4] = (wc_xcp_region_t){ xcp->config.gearbox_base, wc_gearbox_image_payload_bytes };
+}
+
+void wc_xcp_set_gearbox(wc_xcp_t *xcp, const uint8_t *gearbox_payload)
+{
+    WC_ASSERT(xcp != NULL);
+    if (xcp != NULL) { xcp->gearbox_page = gearbox_payload; }
 }
 
 /* The bytes at [address, address + length) when they lie inside one
@@ -112,10 +120,11 @@ static uint32_t resolve(wc_xcp_t *x, uint32_t address, uint32_t extension, uint3
     wc_xcp_regions(x, regions);
     uint8_t *const base[WC_XCP_REGIONS] = {  /* cppcheck-suppress constVariable ; written through (DOWNLOAD) */
         (x->xcp_page == 0u) ? x->working_page : (uint8_t *)(uintptr_t)x->reference_page,
-        (uint8_t *)x->loop, (uint8_t *)&x->status, (uint8_t *)x->id };
+        (uint8_t *)x->loop, (uint8_t *)&x->status, (uint8_t *)x->id, (uint8_t *)(uintptr_t)x->gearbox_page };
     for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
         const uint32_t offset = address - regions[r].base;  /* wraps for an address below the base */
         if ((address >= regions[r].base) && (offset <= regions[r].size) && (length <= regions[r].size - offset)) {
+            if (base[r] == NULL) { return WC_XCP_ERR_ACCESS_DENIED; }  /* no gearbox given */
             if (write && ((r != 0u) || (x->xcp_page != 0u))) { return WC_XCP_ERR_WRITE_PROTECTED; }
             *bytes = base[r] + offset;
             return XCP_OK;

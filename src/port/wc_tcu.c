@@ -28,6 +28,7 @@
 
 #include "wetclutch/wc_config.h"
 #include "wetclutch_can/wc_loop.h"
+#include "wetclutch_can/wc_gearbox_image.h"
 #include "wetclutch_can/wc_xcp.h"
 #include "wc_socketcan.h"
 #include "wc_adapt_file.h"
@@ -183,7 +184,7 @@ static void print_xcp_layout(void)
     xcp.config = (wc_xcp_config_t)WC_XCP_CONFIG_DEFAULT;
     wc_xcp_region_t regions[WC_XCP_REGIONS];
     wc_xcp_regions(&xcp, regions);
-    static const char *const region_names[WC_XCP_REGIONS] = {"cal", "loop", "xcp", "id"};
+    static const char *const region_names[WC_XCP_REGIONS] = {"cal", "loop", "xcp", "id", "gearbox"};
     printf("{\n  \"program\": \"wc_tcu\",\n  \"regions\": {");
     for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
         printf("%s\"%s\": {\"base\": %u, \"size\": %u}", r ? ", " : "", region_names[r], regions[r].base,
@@ -378,6 +379,14 @@ static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal
     if (!wc_xcp_init(xcp, loop, reference, &xcp_config)) {
         fprintf(stderr, "wc_tcu: --xcp: the calibration page does not decode (a bug: the loop accepted it)\n");
         return -1;
+    }
+    if (config->transmission != NULL) {  /* the gearbox region: the table the transmission runs, as its image's payload */
+        static uint8_t gearbox_image[WC_IMAGE_BYTES(WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES)];
+        if (wc_gearbox_image_write(config->transmission->gearbox, gearbox_image, sizeof gearbox_image) == 0u) {
+            fprintf(stderr, "wc_tcu: --xcp: the gearbox does not fit its image (a bug: the layout grew)\n");
+            return -1;
+        }
+        wc_xcp_set_gearbox(xcp, &gearbox_image[WC_IMAGE_HEADER_BYTES]);
     }
     return 0;
 }

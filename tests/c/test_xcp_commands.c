@@ -13,6 +13,13 @@
  * wc_test_xcp_harness.h. */
 #include "wc_test_xcp_harness.h"
 
+#include <string.h>
+
+#include <wetclutch_can/wc_gearbox_image.h>
+
+#include "generated/wc_gearbox_image_layout.h"
+#include "wc_8hp_gearbox.h"
+
 /* ======================================================================== */
 /* Positive responses                                                       */
 /* ======================================================================== */
@@ -211,7 +218,7 @@ static void test_command_errors(void **state)
     wc_xcp_regions(&rig.xcp, regions);
     assert_int_equal(regions[0].size, PAYLOAD);
     assert_int_equal(regions[1].size, sizeof(wc_loop_t));
-    for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
+    for (uint32_t r = 0u; r < WC_XCP_REGIONS - 1u; ++r) {  /* the gearbox region (none given here): below */
         const uint32_t end = regions[r].base + regions[r].size;
         EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(end - 3u)), WC_XCP_ERR_ACCESS_DENIED);
         EXPECT_OK(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(end - 4u)));
@@ -232,6 +239,37 @@ static void test_command_errors(void **state)
     assert_int_equal(rig.xcp.status.pages_accepted + rig.xcp.status.pages_rejected, 0u);
     /* every command but CONNECT, the 7 SET_MTAs and the 4 uploads of a region's last bytes was an error */
     assert_int_equal(rig.xcp.status.errors, rig.xcp.status.commands - 1u - 7u - 4u);
+}
+
+/* The gearbox region (issue 29 item 1): the payload of the gearbox image the transmission runs, read only;
+ * without one, denied. */
+static void test_gearbox_region(void **state)
+{
+    (void)state;
+    static uint8_t image[WC_IMAGE_BYTES(WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES)];
+    static uint8_t uploaded[WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES];
+    const uint32_t base = xcp_config.gearbox_base;
+    const uint32_t n = wc_gearbox_image_payload_bytes;
+    connect();
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(base)), WC_XCP_ERR_ACCESS_DENIED);
+    assert_int_equal(wc_gearbox_image_write(&wc_gearbox_8hp, image, sizeof image), WC_IMAGE_BYTES(n));
+    const uint8_t *payload = &image[WC_IMAGE_HEADER_BYTES];
+    wc_xcp_set_gearbox(&rig.xcp, payload);
+    wc_xcp_region_t regions[WC_XCP_REGIONS];
+    wc_xcp_regions(&rig.xcp, regions);
+    assert_int_equal(regions[4].base, base);
+    assert_int_equal(regions[4].size, n);
+    upload(base, uploaded, n);
+    assert_memory_equal(uploaded, payload, n);
+    /* the A2L's gearbox.ratio[3] at its layout offset: the compiled-in table's 3rd gear */
+    assert_memory_equal(&uploaded[WC_GEARBOX_IMAGE_OFFSET_RATIO + 4u * 3u], &wc_gearbox_8hp.ratio[3], 4u);
+    EXPECT_OK(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(base + n - 4u)));
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(base + n - 3u)), WC_XCP_ERR_ACCESS_DENIED);
+    set_mta(base + 4u * 3u);
+    EXPECT_ERR(download_n(BYTES(0, 0, 0, 0), 4u, 1u), WC_XCP_ERR_WRITE_PROTECTED);
+    assert_memory_equal(uploaded, payload, n);
+    wc_xcp_set_gearbox(&rig.xcp, NULL);
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(base)), WC_XCP_ERR_ACCESS_DENIED);
 }
 
 static void test_frames_without_answer(void **state)
@@ -282,6 +320,7 @@ int main(void)
         cmocka_unit_test_setup(test_upload_measurements, setup),
         cmocka_unit_test_setup(test_calibration_page_commands, setup),
         cmocka_unit_test_setup(test_command_errors, setup),
+        cmocka_unit_test_setup(test_gearbox_region, setup),
         cmocka_unit_test_setup(test_frames_without_answer, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -171,6 +171,8 @@ def _check_program(path: str, args: list[str]) -> list[str]:
     if not cmake.is_file() or not re.search(r"add_executable\(%s\s" % re.escape(name), cmake.read_text()):
         return problems + [f"`{path}`: src/{folder}/CMakeLists.txt builds no {name}"]
     source = (ROOT / "src" / folder / f"{name}.c").read_text(encoding="utf-8")
+    if "wc_tcu_gearbox_option(" in source:   # the transmission's options: one parser for wc_tcu and wc_replay
+        source += (ROOT / "src" / "port" / "wc_tcu_gearbox.c").read_text(encoding="utf-8")
     for o in _options(args):
         if f'"{o}"' not in source and f'{{"{o[2:]}",' not in source:
             problems.append(f"`{name} {o}`: src/{folder}/{name}.c parses no such option")

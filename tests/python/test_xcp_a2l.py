@@ -8,7 +8,7 @@ import json
 import pytest
 
 from cli_support import assert_one_line_error, run
-from wetclutch.calibration import image_layout
+from wetclutch.calibration import gearbox_image, image_layout
 from wetclutch.calibration.measurements import SIGNALS, TYPES
 from wetclutch.generate import a2l, xcp_signals
 from wetclutch.hil import xcp_session
@@ -38,19 +38,44 @@ def test_program_layout_matches_the_sources(layout):
     bases = sorted(r["base"] for r in layout["regions"].values())
     spans = sorted((r["base"], r["base"] + r["size"]) for r in layout["regions"].values())
     assert all(a[1] <= b[0] for a, b in zip(spans, spans[1:])), "regions overlap"
-    assert len(set(bases)) == 4
+    assert len(set(bases)) == 5
+    assert layout["regions"]["gearbox"]["size"] == gearbox_image.payload_bytes()
 
 
 def test_every_characteristic_at_its_layout_offset(layout, parsed):
     _, desc = parsed
     chars = desc["characteristics"]
     base = layout["regions"]["cal"]["base"]
-    assert set(chars) == {f.name for f in image_layout.FIELDS}
+    gearbox_base = layout["regions"]["gearbox"]["base"]
+    assert set(chars) == {f.name for f in image_layout.FIELDS} | {f.name for f in gearbox_image.FIELDS}
     for f in image_layout.FIELDS:
         address, deposit, kind = chars[f.name]
         assert address == base + f.offset, f.name
         assert deposit == a2l.A2L_TYPES[f.ctype][1], f.name
         assert kind == ("VALUE" if f.count == 1 else "VAL_BLK"), f.name
+    for f in gearbox_image.FIELDS:   # the gearbox region (issue 29 item 1)
+        address, deposit, kind = chars[f.name]
+        assert address == gearbox_base + f.offset, f.name
+        assert deposit == a2l.A2L_TYPES[f.ctype][1], f.name
+        assert kind == ("VAL_BLK" if f.dims else "VALUE"), f.name
+
+
+def test_gearbox_characteristics_are_read_only_tables(parsed):
+    """The gearbox's characteristics: READ_ONLY (the slave refuses a write there), arrays with their C
+    dimensions (the last index fastest: [shift][element] is MATRIX_DIM 6 64)."""
+    import pya2l
+    from pya2l import model
+    path, _ = parsed
+    session = pya2l.import_a2l(str(path), in_memory=True, progress_bar=False, loglevel="ERROR")
+    chars = {c.name: c for c in session.query(model.Characteristic).all()}
+    for f in gearbox_image.FIELDS:
+        c = chars[f.name]
+        assert c.read_only is True, f.name
+        dims = [gearbox_image.BOUNDS[d] for d in reversed(f.dims)]
+        assert (list(c.matrix_dim.numbers) if c.matrix_dim is not None else []) == dims, f.name
+    for c in chars.values():
+        if not c.name.startswith("gearbox."):
+            assert c.read_only is False, c.name
 
 
 def test_every_measurement_at_the_programs_address(layout, parsed):
@@ -72,7 +97,7 @@ def test_units_and_limits_from_the_sources(parsed):
     session = pya2l.import_a2l(str(path), in_memory=True, progress_bar=False, loglevel="ERROR")
     units = {c.name: c.unit for c in session.query(model.CompuMethod).all()}
     for c in session.query(model.Characteristic).all():
-        f = image_layout.BY_NAME[c.name]
+        f = image_layout.BY_NAME.get(c.name) or gearbox_image.BY_NAME[c.name]
         assert units[c.conversion] == f.unit, c.name
         # the A2L writes the float's repr: the limit exactly
         assert (c.lowerLimit, c.upperLimit) == (pytest.approx(f.lower, rel=0), pytest.approx(f.upper, rel=0)), c.name

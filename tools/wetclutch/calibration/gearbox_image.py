@@ -112,9 +112,9 @@ _FIELDS = (
           RATIO_MAX, "the on-coming element's a (its slip per unit of the controller's)"),
     Field("gearbox.shift.offgoing_slip_scale", "shift[{0}].offgoing_slip_scale", "f32", _S, "1", -RATIO_MAX,
           RATIO_MAX, "the off-going element's a"),
-    Field("gearbox.shift.turbine_inertia_kg_m2", "shift[{0}].turbine_inertia_kg_m2", "f32", _S, "kg m^2",
+    Field("gearbox.shift.turbine_inertia_kg_m2", "shift[{0}].turbine_inertia_kg_m2", "f32", _S, "kg*m^2",
           1e-4, 100.0, "reduced model: turbine-side inertia (paper 2, Fig. 1)"),
-    Field("gearbox.shift.output_inertia_kg_m2", "shift[{0}].output_inertia_kg_m2", "f32", _S, "kg m^2",
+    Field("gearbox.shift.output_inertia_kg_m2", "shift[{0}].output_inertia_kg_m2", "f32", _S, "kg*m^2",
           1e-4, 1e5, "reduced model: output-side inertia with the vehicle"),
     Field("gearbox.shift.jerk_per_torque_rate", "shift[{0}].jerk_per_torque_rate", "f32", _S,
           "(m/s^3)/(Nm/s)", 0.0, 1.0, "output jerk per rate of the controller's torque"),
@@ -143,16 +143,16 @@ def _zeros() -> dict:
     return {f.name: ([0] * f.count if f.dims else 0) for f in FIELDS}
 
 
-def values_from_table(table: dict, table_name: str = "shift table") -> dict:
-    """The image's values of a generated shift table (wetclutch.gearbox.table; the dict of its TOML), the
-    same numbers lut/wc_<name>_gearbox.h carries. GearboxImageError if it does not fit the bounds."""
+def table_parts(table: dict, table_name: str) -> tuple[list, dict, list, list]:
+    """(elements, gears, forward gear numbers, shifts) of a generated shift table that fits wc_gearbox_t's
+    bounds (the header's and the image's); GearboxImageError naming what does not."""
     elements = list(table["elements"])
     gears = table["gears"]
     forward = sorted(int(g) for g in gears if g != REVERSE)
     shifts = list(table.get("shifts", {}).values())
     if len(elements) > ELEMENTS or len(forward) > GEARS - 1 or len(shifts) > SHIFTS:
         raise GearboxImageError(f"{table_name}: {len(elements)} elements, {len(forward)} forward gears,"
-                                f" {len(shifts)} shifts: more than the image's bounds ({ELEMENTS}, {GEARS - 1},"
+                                f" {len(shifts)} shifts: more than wc_gearbox.h's bounds ({ELEMENTS}, {GEARS - 1},"
                                 f" {SHIFTS})")
     if forward != list(range(1, len(forward) + 1)):
         raise GearboxImageError(f"{table_name}: forward gears {forward} are not 1..n")
@@ -160,6 +160,13 @@ def values_from_table(table: dict, table_name: str = "shift table") -> dict:
     if missing:
         raise GearboxImageError(f"{table_name}: no reduced model for {', '.join(missing[:3])}: generate the table"
                                 " with --vehicle")
+    return elements, gears, forward, shifts
+
+
+def values_from_table(table: dict, table_name: str = "shift table") -> dict:
+    """The image's values of a generated shift table (wetclutch.gearbox.table; the dict of its TOML), the
+    same numbers lut/wc_<name>_gearbox.h carries. GearboxImageError if it does not fit the bounds."""
+    elements, gears, forward, shifts = table_parts(table, table_name)
     index = {name: i for i, name in enumerate(elements)}
     per_gear = {len(g["closed"]) for g in gears.values()}
     v = _zeros()

@@ -127,15 +127,21 @@ def source_text() -> str:
              *_body(_get), "}", "",
              "const wc_cal_image_limit_t wc_cal_image_loop_limits[WC_CAL_IMAGE_LOOP_FIELDS] = {",
              *(f"    {{ {macro(f)}, {int(f.lower)}u, {int(f.upper)}u }},  /* {f.name} */" for f in loop), "};", "",
-             "typedef struct {", "    uint16_t offset;", "    uint16_t bytes;", "    const char *name;",
-             "} field_name_t;", "",
-             "static const field_name_t field_names[] = {",
-             *(f"    {{ {macro(f)}, {f.bytes}u, \"{f.name}\" }}," for f in layout.FIELDS), "};", "",
-             "const char *wc_cal_image_field_name(uint32_t offset)", "{",
-             "    for (size_t i = 0u; i < sizeof field_names / sizeof field_names[0]; ++i) {",
-             "        if ((offset >= field_names[i].offset) && (offset < (uint32_t)field_names[i].offset + field_names[i].bytes)) {",
-             "            return field_names[i].name;", "        }", "    }", "    return NULL;", "}"]
+             *field_name_lookup("wc_cal_image_field_name", ((macro(f), f.bytes, f.name) for f in layout.FIELDS))]
     return "\n".join(lines) + "\n"
+
+
+def field_name_lookup(function: str, fields) -> list[str]:
+    """C lines of `const char *FUNCTION(uint32_t offset)`: the name of the field (offset macro, bytes, name)
+    holding a payload byte offset, NULL past the payload."""
+    return ["typedef struct {", "    uint16_t offset;", "    uint16_t bytes;", "    const char *name;",
+            "} field_name_t;", "",
+            "static const field_name_t field_names[] = {",
+            *(f"    {{ {offset}, {size}u, \"{name}\" }}," for offset, size, name in fields), "};", "",
+            f"const char *{function}(uint32_t offset)", "{",
+            "    for (size_t i = 0u; i < sizeof field_names / sizeof field_names[0]; ++i) {",
+            "        if ((offset >= field_names[i].offset) && (offset < (uint32_t)field_names[i].offset + field_names[i].bytes)) {",
+            "            return field_names[i].name;", "        }", "    }", "    return NULL;", "}"]
 
 
 def files() -> dict[Path, str]:

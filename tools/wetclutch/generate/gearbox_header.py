@@ -12,10 +12,11 @@ import re
 import tomllib
 from pathlib import Path
 
+from ..calibration import gearbox_image
 from ..util.atomic import Staged
 from .lut import c_float
 
-REVERSE = "R"
+REVERSE = gearbox_image.REVERSE
 
 
 class GearboxHeaderError(ValueError):
@@ -27,19 +28,10 @@ def _identifier(stem: str) -> str:
 
 
 def header_text(table: dict, table_name: str, command: str) -> str:
-    elements = list(table["elements"])
-    gears = table["gears"]
-    forward = sorted(int(g) for g in gears if g != REVERSE)
-    shifts = list(table.get("shifts", {}).values())
-    if len(elements) > 6 or len(forward) > 10 or len(shifts) > 64:
-        raise GearboxHeaderError(f"{table_name}: {len(elements)} elements, {len(forward)} forward gears, {len(shifts)}"
-                                 " shifts: more than wc_gearbox.h's bounds (6, 10, 64)")
-    if forward != list(range(1, len(forward) + 1)):
-        raise GearboxHeaderError(f"{table_name}: forward gears {forward} are not 1..n")
-    missing = [s["source"] + "-" + s["target"] for s in shifts if "turbine_inertia" not in s]
-    if missing:
-        raise GearboxHeaderError(f"{table_name}: no reduced model for {', '.join(missing[:3])}: generate the table"
-                                 " with --vehicle")
+    try:
+        elements, gears, forward, shifts = gearbox_image.table_parts(table, table_name)
+    except gearbox_image.GearboxImageError as e:
+        raise GearboxHeaderError(str(e)) from None
     index = {name: i for i, name in enumerate(elements)}
     closed = [set(gears[g]["closed"]) for g in gears]
     per_gear = {len(c) for c in closed}

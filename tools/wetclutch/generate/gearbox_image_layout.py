@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from ..calibration import gearbox_image as layout
-from .cal_image_layout import generator_main, write_generated
+from .cal_image_layout import field_name_lookup, generator_main, write_generated
 from .lut import banner
 
 COMMAND = "python -m wetclutch.generate.gearbox_image_layout"
@@ -115,7 +115,9 @@ def source_text() -> str:
              "#include \"wetclutch/wc_config.h\"", "#include \"wetclutch/wc_image.h\"",
              "#include \"wetclutch_can/wc_gearbox_image.h\"", "",
              "const uint32_t wc_gearbox_image_payload_bytes = WC_GEARBOX_IMAGE_PAYLOAD_BYTES;", "",
-             "WC_STATIC_ASSERT(WC_GEARBOX_IMAGE_PAYLOAD_BYTES <= WC_IMAGE_PAYLOAD_MAX_BYTES, payload_fits_an_image);",
+             "WC_STATIC_ASSERT(WC_GEARBOX_IMAGE_PAYLOAD_BYTES <= WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES,"
+             " payload_fits_its_buffers);",
+             "WC_STATIC_ASSERT(WC_GEARBOX_IMAGE_MAX_PAYLOAD_BYTES <= WC_IMAGE_PAYLOAD_MAX_BYTES, payload_fits_an_image);",
              f"WC_STATIC_ASSERT(WC_GEARBOX_ELEMENTS_MAX == {layout.ELEMENTS}u, elements_as_the_layout);",
              f"WC_STATIC_ASSERT(WC_GEARBOX_GEARS_MAX == {layout.GEARS}u, gears_as_the_layout);",
              f"WC_STATIC_ASSERT(WC_GEARBOX_SHIFTS_MAX == {layout.SHIFTS}u, shifts_as_the_layout);",
@@ -129,14 +131,7 @@ def source_text() -> str:
              *_row_table("GEARS"), "};", "",
              "const wc_gearbox_image_rows_t wc_gearbox_image_shift_rows[WC_GEARBOX_IMAGE_SHIFT_FIELDS] = {",
              *_row_table("SHIFTS"), "};", "",
-             "typedef struct {", "    uint16_t offset;", "    uint16_t bytes;", "    const char *name;",
-             "} field_name_t;", "",
-             "static const field_name_t field_names[] = {",
-             *(f"    {{ {macro(f)}, {f.bytes}u, \"{f.name}\" }}," for f in layout.FIELDS), "};", "",
-             "const char *wc_gearbox_image_field_name(uint32_t offset)", "{",
-             "    for (size_t i = 0u; i < sizeof field_names / sizeof field_names[0]; ++i) {",
-             "        if ((offset >= field_names[i].offset) && (offset < (uint32_t)field_names[i].offset + field_names[i].bytes)) {",
-             "            return field_names[i].name;", "        }", "    }", "    return NULL;", "}"]
+             *field_name_lookup("wc_gearbox_image_field_name", ((macro(f), f.bytes, f.name) for f in layout.FIELDS))]
     return "\n".join(lines) + "\n"
 
 

@@ -33,9 +33,10 @@ def write_plan(a2l: Path, image: Path, out: Path) -> dict:
     desc = read_a2l(a2l)
     payload = image_format.read_image(Path(image).read_bytes(), image_layout.MAGIC, image_layout.VERSION,
                                       image_layout.payload_bytes(), what=str(image))
-    base = desc["segments"]["calibration"][0]
+    base, size = desc["segments"]["calibration"]
     chars = {name: (address, payload[address - base:address - base + 4].hex())
-             for name, (address, _deposit, _kind) in desc["characteristics"].items()}
+             for name, (address, _deposit, _kind) in desc["characteristics"].items()
+             if base <= address < base + size}   # the calibration page's (the gearbox region's: a transmission's)
     plan = {"characteristics": chars, "measurements": desc["measurements"], "segments": desc["segments"]}
     Path(out).write_text(json.dumps(plan, indent=1))
     return plan
