@@ -1,10 +1,12 @@
 /* The transmission (include/wetclutch/wc_transmission.h) for Python's ctypes:
  * tools/wetclutch/shift/transmission8.py drives wc_transmission_step in
- * process, in lockstep with the 8-speed plant, on the 8HP table
- * (lut/wc_8hp_gearbox.h). The calibrations come as calibration images (the
- * firmware's own decoder, wc_cal_image_load): one per element (its clutch),
- * one more whose shift part is the shift calibration. A host tool: no
- * arithmetic of its own, only the flat interface ctypes needs.
+ * process, in lockstep with the 8-speed plant. Everything comes as images,
+ * through the firmware's own decoders: the gearbox table as a gearbox image
+ * (wc_gearbox_image_load: the table of the plant's own gearbox description,
+ * `wetclutch gearbox --image`; a gearbox of HOST_ELEMENTS elements), then one
+ * calibration image per element (its clutch, wc_cal_image_load), one more
+ * whose shift part is the shift calibration. A host tool: no arithmetic of
+ * its own, only the flat interface ctypes needs.
  *
  * Two ways in (wc_host_tx_init, wc_host_tx_init_frames): wc_transmission_step
  * called directly, or the frame loop with config.transmission (wc_loop.h; the
@@ -20,14 +22,14 @@
 #include <wetclutch/wc_transmission.h>
 #include <wetclutch/wetclutch.h>
 #include <wetclutch_can/wc_cal_image.h>
+#include <wetclutch_can/wc_gearbox_image.h>
 #include <wetclutch_can/wc_loop.h>
-
-#include "wc_8hp_gearbox.h"
 
 #define HOST_ELEMENTS 5u
 #define HOST_REPORT_FIELDS 9u
 
 typedef struct {
+    wc_gearbox_t gearbox;
     wc_cal_set_t element[HOST_ELEMENTS];
     wc_cal_set_t shift;
     wc_transmission_config_t config;
@@ -89,23 +91,28 @@ size_t wc_host_tx_learned_size(void) { return sizeof(wc_adapt_values_t); }
 size_t wc_host_tx_size(void) { return sizeof(wc_host_tx_t); }
 size_t wc_host_tx_step_size(void) { return sizeof(wc_host_tx_step_t); }
 
-/* images: HOST_ELEMENTS + 1 images back to back, lengths[i] bytes each. Returns 0, 100 + i for image i
- * refused (its status result in the low bits: 100 + 10 i + result is not needed: i is enough), or 200 + the
+/* images: the gearbox image, then HOST_ELEMENTS + 1 calibration images, back to back, lengths[i] bytes each.
+ * Returns 0, 100 for a gearbox image refused or not of HOST_ELEMENTS elements, 101 + e for element e's image
+ * refused, 101 + HOST_ELEMENTS for the shift image refused or without shift control, or 200 + the
  * transmission's error. */
 int wc_host_tx_init(wc_host_tx_t *h, const uint8_t *images, const uint32_t *lengths, uint32_t gear, float theta_degC,
                     float margin_factor, float floor_Nm)
 {
     if ((h == NULL) || (images == NULL) || (lengths == NULL)) { return 1; }
     (void)memset(h, 0, sizeof *h);
-    size_t offset = 0u;
+    if ((wc_gearbox_image_load(images, lengths[0], &h->gearbox).result != (uint32_t)WC_GEARBOX_IMAGE_OK) ||
+        (h->gearbox.element_count != HOST_ELEMENTS)) {
+        return 100;
+    }
+    size_t offset = lengths[0];
     for (uint32_t i = 0u; i <= HOST_ELEMENTS; ++i) {
         wc_cal_set_t *set = (i < HOST_ELEMENTS) ? &h->element[i] : &h->shift;
-        const wc_cal_image_status_t status = wc_cal_image_load(images + offset, lengths[i], set);
-        if (status.result != (uint32_t)WC_CAL_IMAGE_OK) { return 100 + (int)i; }
-        offset += lengths[i];
+        const wc_cal_image_status_t status = wc_cal_image_load(images + offset, lengths[1u + i], set);
+        if (status.result != (uint32_t)WC_CAL_IMAGE_OK) { return 101 + (int)i; }
+        offset += lengths[1u + i];
     }
-    if (!h->shift.shift_enabled) { return 100 + (int)HOST_ELEMENTS; }
-    h->config.gearbox = &wc_gearbox_8hp;
+    if (!h->shift.shift_enabled) { return 101 + (int)HOST_ELEMENTS; }
+    h->config.gearbox = &h->gearbox;
     for (uint32_t e = 0u; e < HOST_ELEMENTS; ++e) { h->config.element[e] = &h->element[e].clutch; }
     h->config.shift = &h->shift.shift;
     h->config.holding_margin_factor = margin_factor;

@@ -275,3 +275,43 @@ def test_plots_option_and_exit_codes(monkeypatch, tmp_path):
     assert t8.main(["--matrix", "--out", str(tmp_path)]) == 2
     monkeypatch.setattr(t8, "run_matrix", lambda out, *a: 0)
     assert t8.main(["--matrix", "--out", str(tmp_path)]) == 2
+
+
+def _user_box(tmp_path, *replace: tuple[str, str]) -> str:
+    """The 8HP description copied outside the repository with text changes, and a plant file using it."""
+    text = (t8.ROOT / "tools" / "gearboxes" / "8hp.toml").read_text()
+    for old, new in replace:
+        assert old in text
+        text = text.replace(old, new)
+    text = text.replace(
+        'clutch_calibration = "../calibrations/table1.toml"',
+        f'clutch_calibration = "{t8.ROOT / "tools" / "calibrations" / "table1.toml"}"')
+    (tmp_path / "box.toml").write_text(text)
+    (tmp_path / "plant.toml").write_text(f'extends = "{t8.ROOT / "tools" / "plants" / "8hp" / "nominal.toml"}"\n'
+                                         f'gearbox = "{tmp_path / "box.toml"}"\n')
+    return str(tmp_path / "plant.toml")
+
+
+def test_the_tcu_runs_the_table_of_the_plants_own_gearbox_file(tmp_path):
+    """Issue 29 item 1: a user's gearbox is a file anywhere, and the in-process TCU gets its table as a gearbox
+    image generated from that file (not the compiled-in 8HP's): set 3's sun with 72 teeth instead of 69 moves
+    the 3rd, 4th and 5th ratios, and the TCU's ratios are the plant's kinematics'; a 2->3 upshift completes in
+    the new 3rd. A box whose elements are not A..E is refused with the reason."""
+    from wetclutch.calibration import gearbox_image
+    from wetclutch.gearbox import kinematics
+    plant = _user_box(tmp_path, ('sun_teeth = { value = 69,', 'sun_teeth = { value = 72,'))
+    params = t8._plant_and_models(plant)[0]      # noqa: SLF001
+    image = gearbox_image.read_image(t8.gearbox_image(str(params.gearbox.path)))
+    nominal = gearbox_image.read_image(t8.gearbox_image(str(t8._plant_and_models(str(t8.plant_path("nominal")))[0].gearbox.path)))  # noqa: SLF001,E501
+    for gear in range(1, 9):
+        truth = float(kinematics.ratio(params.gearbox, str(gear)))
+        # the image holds the table's 6 significant digits as a float
+        assert image["gearbox.ratio"][gear] == pytest.approx(truth, rel=2e-6), gear
+    moved = [g for g in range(1, 9) if abs(image["gearbox.ratio"][g] / nominal["gearbox.ratio"][g] - 1) > 1e-3]
+    assert moved == [5, 7]
+    r = t8.run_shift(plant, 4, 5, "power-on upshift")
+    assert r["abort"] == 0 and r["end_gear"] == "5"
+    (tmp_path / "renamed").mkdir()
+    _user_box(tmp_path / "renamed", ('elements.E', 'elements.F'), ('"E"]', '"F"]'))
+    with pytest.raises(t8.ShiftError, match="elements A, B, C, D, F; the in-process TCU"):
+        t8.gearbox_image(str(tmp_path / "renamed" / "box.toml"))

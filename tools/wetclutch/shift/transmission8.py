@@ -11,9 +11,11 @@ controllers' closed loop on a plant richer than their model, nothing more.
 
 The TCU's calibrations: each element's own clutch from the gearbox description (tools/gearboxes/8hp.toml,
 its image as the firmware decodes it), the shift calibration whole_full of tools/calibrations/shift_1_2.toml
-(its driveline replaced per shift by the table's reduced model, in C), the 8HP table of lut/wc_8hp_gearbox.h
-(the nominal vehicle's inertias: on the heavy and light vehicles the TCU's reduced model is off, as a real
-TCU's is). Holding in a gear: the holding need x 1.3, at least 10 Nm.
+(its driveline replaced per shift by the table's reduced model, in C), the gearbox table of the plant's own
+gearbox description as a gearbox image (gearbox_image: `wetclutch gearbox --image` in memory; for the 8HP the
+numbers of lut/wc_8hp_gearbox.h) with the nominal vehicle's inertias (TCU_VEHICLE: on the heavy and light
+vehicles the TCU's reduced model is off, as a real TCU's is). Holding in a gear: the holding need x 1.3, at
+least 30 Nm.
 
 Scenarios (SCENARIOS): per type, the shift, the pedal and the turbine speed at the request:
   power-on upshift    g -> g+1, the pedal for `load` of full load at 2500 rpm
@@ -39,16 +41,19 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import functools
 import json
 import math
 import sys
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..calibration import cal_image, shift as shift_calibration
-from ..gearbox import kinematics
+from .. import gearbox as gearbox_pkg
+from ..calibration import cal_image, gearbox_image as gearbox_images, shift as shift_calibration
+from ..gearbox import kinematics, table as gearbox_table
 from ..simulate.gearbox_plant import Plant8
 from .matrix8 import (CONTROLLER, END_RATIO_TOLERANCE, LOCKUP_MA, OIL_DEGC, RPM, _element_clutch_values,
                       _plant_and_models, pedal_for_load, plant_path)
@@ -56,7 +61,9 @@ from .quality import JERK_CUTOFF_HZ, _lowpass_zero_phase
 from .scenarios import ROOT, SHIFT_TOML, ShiftError
 
 LIBRARY = ROOT / "build" / "host-release" / "src" / "host" / "libwc_transmission_host.so"
-ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
+ELEMENTS = ("A", "B", "C", "D", "E")         # the 8HP's (tools/gearboxes/8hp.toml): element e is bit e
+TCU_VEHICLE = ROOT / "tools" / "plants" / "vehicles" / "nominal.toml"   # the TCU's reduced models' inertias (as
+                                                                        # lut/wc_8hp_gearbox.h's)
 # In a gear each closed element is held at its share of T_t x 1.3, and at least 30 N m: besides T_t's share it
 # carries the open elements' drag and the estimate's error, which at a coast's 15 N m are not small. At 10 N m a
 # coast downshift at 20 degC ended with the on-coming element slipping 0.6 rad/s for good (8->7: C carried 15.6 N m
@@ -113,19 +120,51 @@ def _library(path: Path = LIBRARY):
     return lib
 
 
+@functools.lru_cache(maxsize=8)
+def gearbox_image(gearbox_path) -> bytes:
+    """The TCU's gearbox table as a gearbox image (wc_gearbox_image.h; `wetclutch gearbox --image`): the table
+    of the plant's own gearbox description, its reduced models with TCU_VEHICLE's inertias. ShiftError for a
+    gearbox the in-process TCU does not run (its elements other than ELEMENTS)."""
+    gb = gearbox_pkg.load(str(gearbox_path))
+    text = gearbox_table.text(gb, gearbox_pkg.load_vehicle(str(TCU_VEHICLE)))
+    table = tomllib.loads(text)
+    if tuple(table["elements"]) != ELEMENTS:
+        raise ShiftError(f"{gearbox_path}: elements {', '.join(table['elements'])}; the in-process TCU"
+                         f" (libwc_transmission_host) runs a gearbox of the elements {', '.join(ELEMENTS)}")
+    return gearbox_images.image_bytes_of(gearbox_images.values_from_table(table, str(gearbox_path)))
+
+
+def element_images(gearbox_path) -> list[bytes]:
+    """One calibration image per element: its own clutch (pack, piston, spring, VFS of the description), shift
+    control off (wc_replay --element-image)."""
+    return [cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), e),
+                                         **cal_image._shift_values(None),          # noqa: SLF001
+                                         **cal_image.loop_values(None, False)}) for e in ELEMENTS]
+
+
+def shift_image(gearbox_path, shift=None) -> bytes:
+    """The image whose shift part is the transmission's shift calibration (shift, by default the whole shift's
+    controller of tools/calibrations/shift_1_2.toml; each shift's driveline model is the table's) and whose
+    loop part gives the timeouts; its clutch part is element A's (not used by the transmission)."""
+    base = shift or shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
+    return cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), ELEMENTS[0]),
+                                        **cal_image._shift_values(base),      # noqa: SLF001
+                                        **cal_image.loop_values(None, True)})
+
+
+def tcu_images(gearbox_path, shift=None) -> list[bytes]:
+    """What libwc_transmission_host's init takes, in its order: the gearbox image, each element's image, the
+    shift image."""
+    return [gearbox_image(str(gearbox_path)), *element_images(gearbox_path), shift_image(gearbox_path, shift)]
+
+
 class Transmission:
-    """wc_transmission_step in process on the gearbox's element calibrations and the shift calibration."""
+    """wc_transmission_step in process on the gearbox's table, element calibrations and shift calibration."""
 
     def __init__(self, gearbox_path, gear: int, theta_start_degC: float, lib=None, shift=None):
         """shift: a ShiftCalibration (default the controller's, CONTROLLER of tools/calibrations/shift_1_2.toml)."""
         self.lib = lib or _library()
-        base = shift or shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
-        images = [cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), e),
-                                               **cal_image._shift_values(None),          # noqa: SLF001
-                                               **cal_image.loop_values(None, False)}) for e in ELEMENTS]
-        images.append(cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), ELEMENTS[0]),
-                                                   **cal_image._shift_values(base),      # noqa: SLF001
-                                                   **cal_image.loop_values(None, True)}))
+        images = tcu_images(gearbox_path, shift)
         self.state = ctypes.create_string_buffer(self.lib.wc_host_tx_size())
         lengths = (ctypes.c_uint32 * len(images))(*[len(b) for b in images])
         rc = self.lib.wc_host_tx_init(self.state, b"".join(images), lengths, gear, theta_start_degC,

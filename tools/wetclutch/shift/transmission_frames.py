@@ -19,33 +19,13 @@ from __future__ import annotations
 import ctypes
 from pathlib import Path
 
-from ..calibration import cal_image, shift as shift_calibration
 from ..util import canlog
-from .matrix8 import CONTROLLER, _element_clutch_values
-from .scenarios import SHIFT_TOML, ShiftError
-from .transmission8 import HOLDING_FLOOR_NM, HOLDING_MARGIN, _library, _Step
+from .scenarios import ShiftError
+from .transmission8 import (ELEMENTS, HOLDING_FLOOR_NM, HOLDING_MARGIN, _library, _Step,  # noqa: F401
+                            element_images, shift_image, tcu_images)
 
-ELEMENTS = ("A", "B", "C", "D", "E")         # lut/wc_8hp_gearbox.h: element e is bit e
-GEARBOX = "8hp"                              # wc_replay --gearbox: the table libwc_transmission_host has
+GEARBOX = "8hp"                              # wc_replay --gearbox: the compiled-in table of the 8HP description
 MAX_FRAMES = 2 + 9                           # a step's frames: ShiftCommand, GearboxSensors, WC_LOOP_TX_FRAMES
-
-
-def element_images(gearbox_path) -> list[bytes]:
-    """One calibration image per element: its own clutch (pack, piston, spring, VFS of the description), shift
-    control off (wc_replay --element-image)."""
-    return [cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), e),
-                                         **cal_image._shift_values(None),          # noqa: SLF001
-                                         **cal_image.loop_values(None, False)}) for e in ELEMENTS]
-
-
-def shift_image(gearbox_path) -> bytes:
-    """The image whose shift part is the transmission's shift calibration (the whole shift's controller of
-    tools/calibrations/shift_1_2.toml; each shift's driveline model is the table's) and whose loop part gives
-    the timeouts; its clutch part is element A's (not used by the transmission)."""
-    base = shift_calibration.load(SHIFT_TOML).variants[CONTROLLER]
-    return cal_image.write_image_bytes({**_element_clutch_values(str(gearbox_path), ELEMENTS[0]),
-                                        **cal_image._shift_values(base),      # noqa: SLF001
-                                        **cal_image.loop_values(None, True)})
 
 
 class FrameTransmission:
@@ -58,7 +38,7 @@ class FrameTransmission:
         self.lib.wc_host_tx_init_frames.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(u), u, f, f, f]
         self.lib.wc_host_tx_frames.argtypes = [ctypes.c_void_p, ctypes.POINTER(u), ctypes.c_char_p, u]
         self.lib.wc_host_tx_frames.restype = u
-        images = [*element_images(gearbox_path), shift_image(gearbox_path)]
+        images = tcu_images(gearbox_path)
         self.state = ctypes.create_string_buffer(self.lib.wc_host_tx_size())
         lengths = (u * len(images))(*[len(b) for b in images])
         rc = self.lib.wc_host_tx_init_frames(self.state, b"".join(images), lengths, gear, theta_start_degC,
