@@ -33,8 +33,9 @@
  * for LOCKED; force within [0, F_max]; the estimate within the envelope.
  * A rejected calibration must make wc_model_init fail with the same code.
  *
- * Byte 0 with bit 7 set (FZ_ADAPT_IMAGE_INPUT): the input is an adaptation
- * image instead, read and checked by fuzz_adapt_image.c (the persistent image
+ * Byte 0 with bits 7 and 6 set (FZ_GEARBOX_IMAGE_INPUT): a gearbox image
+ * instead, fuzz_gearbox_image.c. Byte 0 with bit 7 alone (FZ_ADAPT_IMAGE_INPUT):
+ * the input is an adaptation image instead, read and checked by fuzz_adapt_image.c (the persistent image
  * format's loader, DESIGN 12: a fourth harness would add a minute to
  * scripts/test.sh, see README.md). */
 #include <float.h>
@@ -46,6 +47,7 @@
 #include <wetclutch/wetclutch.h>
 
 #include "fuzz_adapt_image.h"
+#include "fuzz_gearbox_image.h"
 #include "wc_fuzz_common.h"
 #include "wc_table1_calibration.h"
 
@@ -65,9 +67,13 @@ static void report_acceptance(void)
 {
     unsigned long images;
     unsigned long loaded;
+    unsigned long gearboxes;
+    unsigned long gearboxes_loaded;
     fz_adapt_image_counts(&images, &loaded);
+    fz_gearbox_image_counts(&gearboxes, &gearboxes_loaded);
     fprintf(stderr, "fuzz_calibration: %lu inputs, %lu accepted by wc_calibration_check and evaluated; "
-            "%lu adaptation images, %lu loaded\n", inputs, accepted, images, loaded);
+            "%lu adaptation images, %lu loaded; %lu gearbox images, %lu loaded\n", inputs, accepted, images, loaded,
+            gearboxes, gearboxes_loaded);
 }
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
@@ -333,6 +339,10 @@ static void print_calibration(const wc_calibration_t *c)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    if ((size > 0u) && ((data[0] & FZ_GEARBOX_IMAGE_INPUT) == FZ_GEARBOX_IMAGE_INPUT)) {
+        fz_gearbox_image_input(data, size, verbose);
+        return 0;
+    }
     if ((size > 0u) && ((data[0] & FZ_ADAPT_IMAGE_INPUT) != 0u)) {
         fz_adapt_image_input(data, size, verbose);
         return 0;

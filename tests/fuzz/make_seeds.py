@@ -177,8 +177,31 @@ def adapt_image_seeds():
     }
 
 
+# gearbox images: fuzz_calibration with byte 0 bits 7 and 6 set (fuzz_gearbox_image.c)
+
+def gearbox_image_seeds():
+    import sys
+    sys.path.insert(0, str(HERE.parent.parent / "tools"))
+    import tomllib
+    from wetclutch.calibration import gearbox_image as layout
+    with open(HERE.parent.parent / "tools" / "gearboxes" / "8hp_shifts.toml", "rb") as f:
+        image = layout.image_bytes_of(layout.values_from_table(tomllib.load(f)))
+
+    def word(name, index=0):
+        return struct.pack("<H", layout.BY_NAME[name].offset // 4 + index)
+    return {
+        "gearbox_image_raw": bytes([0xC0, 0]) + image,                                           # as is: loads
+        "gearbox_image_8hp": bytes([0xC0, 1]),                                                   # no edit: loads
+        "gearbox_image_oncoming_259": bytes([0xC0, 1]) + word("gearbox.shift.oncoming", 5) + bytes([1])
+        + struct.pack("<H", 259),                                                                # BAD_FIELD
+        "gearbox_image_ratio_minus_1": bytes([0xC0, 1]) + word("gearbox.ratio", 3) + bytes([3]),  # a ulp lower
+        "gearbox_image_unused": bytes([0xC0, 3]) + word("gearbox.shift.output_ratio", 40),       # BAD_FIELD
+        "gearbox_image_cut": bytes([0xC0, 2]) + struct.pack("<HBH", 100, 0x10, 6000),            # BAD_CRC / cut
+    }
+
+
 def main():
-    calibration = {**calibration_seeds(), **adapt_image_seeds()}
+    calibration = {**calibration_seeds(), **adapt_image_seeds(), **gearbox_image_seeds()}
     for name, seeds in (("model", model_seeds()), ("loop", loop_seeds()), ("calibration", calibration),
                          ("gearbox", gearbox_seeds())):
         folder = CORPUS / name
