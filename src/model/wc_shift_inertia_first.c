@@ -238,7 +238,7 @@ typedef struct {
 /* The phase's law; may change the phase (PREPARE -> INERTIA). */
 static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t *cal, float slip_rad_s, float dt_s,
                                  bool offgoing_saturated, bool oncoming_saturated, bool assist, bool engine,
-                                 float oncoming_model_Nm)
+                                 float oncoming_model_Nm, float oncoming_viscous_Nm)
 {
     requests_t r = { 0.0f, 0.0f, 0.0f, false, true };
     const float t_t_Nm = shift->turbine_torque_Nm;
@@ -374,7 +374,14 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         shift->flare_integral_Nm = (integral_Nm < limit_Nm) ? integral_Nm : limit_Nm;
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }
     }
-    r.oncoming_Nm = hold_Nm * x + cal->flare_kp_Nm_per_rad_s * past_rad_s + shift->flare_integral_Nm;
+    /* the tip-out's hand-over: the on-coming clutch must hold the engine's drag by friction, and the viscous
+     * drag at the slip left vanishes as it locks, so the inverse (at the measured slip) is asked for it on top;
+     * else a cold pack at its kiss point carries that small T_t by its drag alone at a slip that never closes
+     * (the 8HP's 6->7 and 5->7 at 20 degC: 4 rad/s of A's own slip for 0.9 s at its kiss point, lock-up failed).
+     * Not in a kickdown: its T_t share dominates the drag, and the cold drag added as friction jerked (3->2 at
+     * 25 % load 9.6 -> 15.4 m/s^3, 7->6 at full load 11.9 -> 18.4) */
+    const float drag_Nm = (assist && (phase == (uint32_t)WC_SHIFT_TORQUE)) ? fabsf(oncoming_viscous_Nm) : 0.0f;
+    r.oncoming_Nm = hold_Nm * x + cal->flare_kp_Nm_per_rad_s * past_rad_s + shift->flare_integral_Nm + drag_Nm;
     r.engine_Nm = (engine && (phase == (uint32_t)WC_SHIFT_TORQUE)) ? (shift->engine_from_Nm * (1.0f - x)) : 0.0f;
     r.offgoing_Nm = shift->phase_start_request_Nm * (1.0f - x);
     /* nothing to hand over (the tip-out's hold-back ended at 0: the on-coming clutch pushed): open at once,
@@ -460,7 +467,7 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     const bool oncoming_assist = (options & WC_SHIFT_INERTIA_FIRST_ASSIST) != 0u;
     const bool engine = (options & WC_SHIFT_INERTIA_FIRST_ENGINE) != 0u;
     const requests_t r = phase_requests(shift, cal, slip_rad_s, dt_s, offgoing_saturated, oncoming_saturated,
-                                        oncoming_assist, engine, out->model.torque_Nm);
+                                        oncoming_assist, engine, out->model.torque_Nm, out->model.viscous_Nm);
     /* the on-coming clutch: with the assist (the tip-out) at its kiss point from PREPARE, without the fill
      * pulse: the pulse's overshoot at the whole slip pushed the turbine down at the phase's start (on the 8HP's
      * 3->4 57 N m of the element's torque against the engine's drag of 22, the off-going element held back 66

@@ -315,3 +315,14 @@ def test_the_tcu_runs_the_table_of_the_plants_own_gearbox_file(tmp_path):
     _user_box(tmp_path / "renamed", ('elements.E', 'elements.F'), ('"E"]', '"F"]'))
     with pytest.raises(t8.ShiftError, match="elements A, B, C, D, F; the in-process TCU"):
         t8.gearbox_image(str(tmp_path / "renamed" / "box.toml"))
+
+
+def test_cold_tipout_closes_the_slip_its_drag_holds_open():
+    """A tip-out's hand-over at 20 degC (6->7: A on-coming at 6.2 x the controller's slip): at its kiss point A's
+    viscous drag carried the engine's drag (T_t -21 N m) at 4 rad/s of its own slip, which never closed, and
+    the shift ended in lock-up failed (AbortReason 2) although the plant reached 7th. The on-coming clutch is
+    asked for that drag on top of what it holds (wc_shift_inertia_first.c), and the shift completes."""
+    r = t8.run_shift("nominal", 6, 7, "power-off upshift", oil_degC=20.0)
+    assert r["type"] == "power-off upshift"
+    assert r["abort"] == 0 and r["end_gear"] == "7", r
+    assert r["tie_up_fraction"] <= 0.10 and r["excursion_rpm"] <= 30.0
