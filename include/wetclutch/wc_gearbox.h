@@ -77,10 +77,14 @@ typedef enum {
     WC_GEARBOX_SHIFT_ELEMENTS,  /* on-coming / off-going not the element that closes / opens */
     WC_GEARBOX_SHIFT_SLIPS,     /* a held element slips, the off-going one not at rest in the source gear or
                                  * the on-coming one not in the target gear, the scales not its a */
-    WC_GEARBOX_SHIFT_MODEL      /* ratios, inertias or the jerk factor out of range */
+    WC_GEARBOX_SHIFT_MODEL,     /* ratios, inertias or the jerk factor out of range */
+    WC_GEARBOX_ERRORS           /* number of codes */
 } wc_gearbox_error_t;
 
 wc_gearbox_error_t wc_gearbox_check(const wc_gearbox_t *gearbox);
+
+/* The name of a wc_gearbox_error_t ("SHIFT_SLIPS"; "unknown" past the codes), for messages. */
+const char *wc_gearbox_error_name(uint32_t error);
 
 /* Why a shift request cannot be made (DESIGN 15; the values of a future DBC
  * signal): computed from the closed masks, not from the table. */

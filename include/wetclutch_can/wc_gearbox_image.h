@@ -50,7 +50,7 @@ typedef enum {
 
 typedef struct {
     uint32_t result;   /* wc_image_status_t or wc_gearbox_image_result_t */
-    uint32_t error;    /* BAD_FIELD: the payload offset; BAD_GEARBOX: wc_gearbox_error_t; else 0 */
+    uint32_t error;    /* BAD_FIELD: the payload offset; BAD_GEARBOX: wc_gearbox_error_t (wc_gearbox_error_name); else 0 */
 } wc_gearbox_image_status_t;
 
 /* The payload's length in bytes (generated with the layout), at most
@@ -64,7 +64,10 @@ wc_gearbox_image_status_t wc_gearbox_image_load(const uint8_t *image, size_t len
 
 /* Writes gearbox's image to image[0..capacity): returns its length,
  * WC_IMAGE_BYTES(wc_gearbox_image_payload_bytes); 0 when it does not fit or
- * an argument is NULL. The gearbox as it is, unchecked (the load checks). */
+ * an argument is NULL. The gearbox as it is, unchecked (the load checks): a
+ * table that passes wc_gearbox_check but holds nonzero values where it does
+ * not use them (a slip of an element past element_count) writes an image the
+ * load refuses (BAD_FIELD). */
 size_t wc_gearbox_image_write(const wc_gearbox_t *gearbox, uint8_t *image, size_t capacity);
 
 /* The name of a result ("OK", "BAD_CRC", "BAD_FIELD", "BAD_GEARBOX";

@@ -179,7 +179,7 @@ typedef struct {
     void *context;
     uint32_t unlock_attempts;     /* 1..255 wrong keys in a row until the lock-out (with the hooks) */
     uint32_t unlock_delay_steps;  /* the lock-out, 1..WC_XCP_UNLOCK_DELAY_MAX_STEPS control steps (with the hooks) */
-    uint32_t gearbox_base;
+    uint32_t gearbox_base;        /* the gearbox region's base (wc_xcp_set_gearbox; last: added with issue 29) */
 } wc_xcp_config_t;
 
 #define WC_XCP_UNLOCK_DELAY_MAX_STEPS 0x7FFFFFFFu
@@ -286,7 +286,9 @@ uint32_t wc_xcp_step(wc_xcp_t *xcp, bool control_step, wc_can_frame_t out[WC_XCP
 /* The gearbox region's bytes: gearbox_payload (wc_gearbox_image_payload_bytes
  * bytes, wc_gearbox_image.h: the payload of the gearbox image the
  * transmission runs, or the compiled-in table's encoded once at start) must
- * outlive the slave; NULL: the region answers ERR_ACCESS_DENIED again. */
+ * outlive the slave; NULL: the region answers ERR_ACCESS_DENIED again (a DAQ
+ * list already pointing into it keeps sampling those bytes, which is why
+ * they must outlive the slave). */
 void wc_xcp_set_gearbox(wc_xcp_t *xcp, const uint8_t *gearbox_payload);
 
 /* The memory regions (for the A2L and wc_tcu --xcp-layout): index 0 cal,

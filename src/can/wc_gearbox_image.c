@@ -19,16 +19,14 @@ static bool word_is_zero(const uint8_t *payload, uint32_t offset)
     return wc_image_get_u32(&payload[offset]) == 0u;
 }
 
-/* The first narrow member whose word does not fit its C type (the offset), or 0 (offset 0 is a u32 field). */
+/* The first narrow member's word that does not fit its C type (its offset), or 0 (offset 0 is not narrow). */
 static uint32_t narrow_out_of_type(const uint8_t *payload)
 {
-    if (wc_image_get_u32(&payload[WC_GEARBOX_IMAGE_OFFSET_HAS_REVERSE]) > 1u) { return WC_GEARBOX_IMAGE_OFFSET_HAS_REVERSE; }
-    static const uint32_t narrow[] = { WC_GEARBOX_IMAGE_OFFSET_SHIFT_SOURCE_GEAR, WC_GEARBOX_IMAGE_OFFSET_SHIFT_TARGET_GEAR,
-                                       WC_GEARBOX_IMAGE_OFFSET_SHIFT_ONCOMING, WC_GEARBOX_IMAGE_OFFSET_SHIFT_OFFGOING };
-    for (size_t f = 0u; f < sizeof narrow / sizeof narrow[0]; ++f) {
-        for (uint32_t i = 0u; i < WC_GEARBOX_SHIFTS_MAX; ++i) {
-            const uint32_t offset = narrow[f] + 4u * i;
-            if (wc_image_get_u32(&payload[offset]) > 0xFFu) { return offset; }
+    for (size_t f = 0u; f < WC_GEARBOX_IMAGE_NARROW_FIELDS; ++f) {
+        const wc_gearbox_image_narrow_t *n = &wc_gearbox_image_narrow[f];
+        for (uint32_t i = 0u; i < n->count; ++i) {
+            const uint32_t offset = (uint32_t)n->offset + 4u * i;
+            if (wc_image_get_u32(&payload[offset]) > (uint32_t)n->max) { return offset; }
         }
     }
     return 0u;
@@ -108,14 +106,6 @@ static const char *const result_names[] = {
 };
 WC_STATIC_ASSERT(sizeof result_names / sizeof result_names[0] == (size_t)WC_GEARBOX_IMAGE_RESULTS, result_name_per_code);
 
-/* wc_gearbox_error_t's names, in its order. */
-static const char *const gearbox_error_names[] = {
-    "OK", "NULL", "COUNTS", "GEAR_RATIO", "GEAR_ELEMENTS", "HOLDING_TORQUE", "SHIFT_GEARS", "SHIFT_ELEMENTS",
-    "SHIFT_SLIPS", "SHIFT_MODEL",
-};
-WC_STATIC_ASSERT(sizeof gearbox_error_names / sizeof gearbox_error_names[0] == (size_t)WC_GEARBOX_SHIFT_MODEL + 1u,
-                 gearbox_error_name_per_code);
-
 const char *wc_gearbox_image_result_name(uint32_t result)
 {
     return (result < (uint32_t)WC_GEARBOX_IMAGE_RESULTS) ? result_names[result] : "unknown";
@@ -127,7 +117,7 @@ const char *wc_gearbox_image_error_name(wc_gearbox_image_status_t status)
     if (status.result == (uint32_t)WC_GEARBOX_IMAGE_BAD_FIELD) {
         name = wc_gearbox_image_field_name(status.error);
     } else if (status.result == (uint32_t)WC_GEARBOX_IMAGE_BAD_GEARBOX) {
-        name = (status.error <= (uint32_t)WC_GEARBOX_SHIFT_MODEL) ? gearbox_error_names[status.error] : NULL;
+        name = wc_gearbox_error_name(status.error);
     } else {
         /* the image's own results name no field */
     }

@@ -207,3 +207,15 @@ wc_shift_cal_error_t wc_gearbox_shift_calibration(const wc_shift_calibration_t *
     out->jerk_per_torque_rate = shift->jerk_per_torque_rate;
     return wc_shift_calibration_check(out);
 }
+
+/* wc_gearbox_error_t's names, in its order. */
+static const char *const error_names[] = {
+    "OK", "NULL", "COUNTS", "GEAR_RATIO", "GEAR_ELEMENTS", "HOLDING_TORQUE", "SHIFT_GEARS", "SHIFT_ELEMENTS",
+    "SHIFT_SLIPS", "SHIFT_MODEL",
+};
+WC_STATIC_ASSERT(sizeof error_names / sizeof error_names[0] == (size_t)WC_GEARBOX_ERRORS, error_name_per_code);
+
+const char *wc_gearbox_error_name(uint32_t error)
+{
+    return (error < (uint32_t)WC_GEARBOX_ERRORS) ? error_names[error] : "unknown";
+}

@@ -85,7 +85,7 @@ int wc_tcu_gearbox_config(const char *program, const wc_tcu_gearbox_options_t *o
         gearbox = &from_image;
     }
     if ((config->shift == NULL) || (config->shift->coordinator != 1u)) {
-        fprintf(stderr, "%s: --gearbox needs a shift calibration with the coordinator (the whole shift's):"
+        fprintf(stderr, "%s: the transmission needs a shift calibration with the coordinator (the whole shift's):"
                         " --shift NAME or an image with it\n", program);
         return 2;
     }

@@ -139,7 +139,10 @@ static void test_the_gearbox_check_applies(void **state)
     assert_int_equal(s.result, WC_GEARBOX_IMAGE_BAD_GEARBOX);
     assert_int_equal(s.error, WC_GEARBOX_COUNTS);
     s = load_with_word(WC_GEARBOX_IMAGE_OFFSET_SHIFT_TURBINE_INERTIA_KG_M2, 0u);
+    assert_int_equal(s.result, WC_GEARBOX_IMAGE_BAD_GEARBOX);
     assert_int_equal(s.error, WC_GEARBOX_SHIFT_MODEL);
+    assert_string_equal(wc_gearbox_error_name(WC_GEARBOX_SHIFT_MODEL), "SHIFT_MODEL");
+    assert_string_equal(wc_gearbox_error_name(WC_GEARBOX_ERRORS), "unknown");
 }
 
 static void test_the_image_format_applies(void **state)

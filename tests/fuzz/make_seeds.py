@@ -196,7 +196,8 @@ def gearbox_image_seeds():
         + struct.pack("<H", 259),                                                                # BAD_FIELD
         "gearbox_image_ratio_minus_1": bytes([0xC0, 1]) + word("gearbox.ratio", 3) + bytes([3]),  # a ulp lower
         "gearbox_image_unused": bytes([0xC0, 3]) + word("gearbox.shift.output_ratio", 40),       # BAD_FIELD
-        "gearbox_image_cut": bytes([0xC0, 2]) + struct.pack("<HBH", 100, 0x10, 6000),            # BAD_CRC / cut
+        "gearbox_image_cut": bytes([0xC0, 2]) + struct.pack("<HBH", 100, 0x10, 6000),            # TRUNCATED
+        "gearbox_image_flipped": bytes([0xC0, 2]) + struct.pack("<HBH", 100, 0x10, 6280),        # BAD_CRC
     }
 
 

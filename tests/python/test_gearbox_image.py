@@ -1,8 +1,8 @@
 """The gearbox image (include/wetclutch_can/wc_gearbox_image.h; tools/wetclutch/calibration/gearbox_image.py;
 issue 29 item 1): its layout is the C struct's and the C headers'; the generated codec regenerates byte for byte;
-``wetclutch gearbox ... --image`` writes the image of the shift table the compiled-in header comes from; a
-TCU given that image (``wc_replay --gearbox-image``) sends the frames it sends with the compiled-in table; a
-refused image stops the program with one line naming the field.
+``wetclutch gearbox ... --image`` writes the image of the shift table the compiled-in header comes from. That a
+TCU given the image (``wc_replay --gearbox-image``) sends the frames of the compiled-in table, and that a refused
+image stops the program with one line naming the field: tests/python/test_transmission_frames.py.
 
 tests/vectors/wc_8hp_gearbox_image.hex is Python's image of tools/gearboxes/8hp_shifts.toml (``python
 tests/python/test_gearbox_image.py`` writes it); tests/c/test_gearbox_image.c loads it into exactly the

@@ -295,8 +295,8 @@ def _user_box(tmp_path, *replace: tuple[str, str]) -> str:
 def test_the_tcu_runs_the_table_of_the_plants_own_gearbox_file(tmp_path):
     """Issue 29 item 1: a user's gearbox is a file anywhere, and the in-process TCU gets its table as a gearbox
     image generated from that file (not the compiled-in 8HP's): set 3's sun with 72 teeth instead of 69 moves
-    the 3rd, 4th and 5th ratios, and the TCU's ratios are the plant's kinematics'; a 2->3 upshift completes in
-    the new 3rd. A box whose elements are not A..E is refused with the reason."""
+    the 5th and 7th ratios (measured), and the TCU's ratios are the plant's kinematics'; a 4->5 upshift
+    completes in the new 5th. A box whose elements are not A..E is refused with the reason."""
     from wetclutch.calibration import gearbox_image
     from wetclutch.gearbox import kinematics
     plant = _user_box(tmp_path, ('sun_teeth = { value = 69,', 'sun_teeth = { value = 72,'))

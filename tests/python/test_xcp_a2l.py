@@ -61,18 +61,31 @@ def test_every_characteristic_at_its_layout_offset(layout, parsed):
 
 
 def test_gearbox_characteristics_are_read_only_tables(parsed):
-    """The gearbox's characteristics: READ_ONLY (the slave refuses a write there), arrays with their C
-    dimensions (the last index fastest: [shift][element] is MATRIX_DIM 6 64)."""
+    """The gearbox's characteristics: READ_ONLY (the slave refuses a write there), and a tool that reshapes a
+    table's bytes by the A2L (pya2ldb's shape and order) sees each value where the C struct has it: the 8HP
+    image's gearbox.shift.slip_a[shift][element] is the table's slip a of that shift's element."""
+    import numpy as np
     import pya2l
     from pya2l import model
+    from pya2l.api import inspect
     path, _ = parsed
     session = pya2l.import_a2l(str(path), in_memory=True, progress_bar=False, loglevel="ERROR")
     chars = {c.name: c for c in session.query(model.Characteristic).all()}
+    values = gearbox_image.read_image(_8hp_gearbox_image())
     for f in gearbox_image.FIELDS:
         c = chars[f.name]
         assert c.read_only is True, f.name
-        dims = [gearbox_image.BOUNDS[d] for d in reversed(f.dims)]
-        assert (list(c.matrix_dim.numbers) if c.matrix_dim is not None else []) == dims, f.name
+        if not f.dims:
+            continue
+        view = inspect.Characteristic(session, f.name)
+        table = np.asarray(values[f.name]).reshape(view.fnc_np_shape, order=view.fnc_np_order)
+        assert table.shape == tuple(gearbox_image.BOUNDS[d] for d in f.dims), f.name
+    slip_a = np.asarray(values["gearbox.shift.slip_a"]).reshape(
+        inspect.Characteristic(session, "gearbox.shift.slip_a").fnc_np_shape,
+        order=inspect.Characteristic(session, "gearbox.shift.slip_a").fnc_np_order)
+    # lut/wc_8hp_gearbox.h's second row, 1-3 (E on, A off): slip a of A -0.811765, of D 1.34725, of E 0.905882
+    assert slip_a[1, 0] == pytest.approx(-0.811765, rel=1e-6) and slip_a[1, 3] == pytest.approx(1.34725, rel=1e-6)
+    assert slip_a[1, 4] == pytest.approx(0.905882, rel=1e-6) and slip_a[1, 1] == 0.0
     for c in chars.values():
         if not c.name.startswith("gearbox."):
             assert c.read_only is False, c.name
@@ -87,6 +100,14 @@ def test_every_measurement_at_the_programs_address(layout, parsed):
         address, datatype = meas[s.name]
         assert address == layout["regions"][s.region]["base"] + offsets[s.name], s.name
         assert datatype == TYPES[s.ctype][0], s.name
+
+
+def _8hp_gearbox_image() -> bytes:
+    import tomllib
+    from pathlib import Path
+    table = Path(__file__).resolve().parents[2] / "tools" / "gearboxes" / "8hp_shifts.toml"
+    with open(table, "rb") as f:
+        return gearbox_image.image_bytes_of(gearbox_image.values_from_table(tomllib.load(f)))
 
 
 def test_units_and_limits_from_the_sources(parsed):

@@ -18,6 +18,7 @@ WC_STATIC_ASSERT(WC_GEARBOX_ELEMENTS_MAX == 6u, elements_as_the_layout);
 WC_STATIC_ASSERT(WC_GEARBOX_GEARS_MAX == 11u, gears_as_the_layout);
 WC_STATIC_ASSERT(WC_GEARBOX_SHIFTS_MAX == 64u, shifts_as_the_layout);
 WC_STATIC_ASSERT(sizeof(wc_gearbox_shift_t) == 80u, every_shift_field_in_the_layout);
+WC_STATIC_ASSERT(sizeof(wc_gearbox_t) == 5492u, every_gearbox_field_in_the_layout);
 
 void wc_gearbox_image_layout_encode(const wc_gearbox_t *gearbox, uint8_t *payload)
 {
@@ -165,6 +166,14 @@ const wc_gearbox_image_rows_t wc_gearbox_image_shift_rows[WC_GEARBOX_IMAGE_SHIFT
     { WC_GEARBOX_IMAGE_OFFSET_SHIFT_TURBINE_INERTIA_KG_M2, 1u, 0u },  /* gearbox.shift.turbine_inertia_kg_m2 */
     { WC_GEARBOX_IMAGE_OFFSET_SHIFT_OUTPUT_INERTIA_KG_M2, 1u, 0u },  /* gearbox.shift.output_inertia_kg_m2 */
     { WC_GEARBOX_IMAGE_OFFSET_SHIFT_JERK_PER_TORQUE_RATE, 1u, 0u },  /* gearbox.shift.jerk_per_torque_rate */
+};
+
+const wc_gearbox_image_narrow_t wc_gearbox_image_narrow[WC_GEARBOX_IMAGE_NARROW_FIELDS] = {
+    { WC_GEARBOX_IMAGE_OFFSET_HAS_REVERSE, 1u, 1u },  /* gearbox.has_reverse (bool) */
+    { WC_GEARBOX_IMAGE_OFFSET_SHIFT_SOURCE_GEAR, 64u, 255u },  /* gearbox.shift.source_gear (uint8_t) */
+    { WC_GEARBOX_IMAGE_OFFSET_SHIFT_TARGET_GEAR, 64u, 255u },  /* gearbox.shift.target_gear (uint8_t) */
+    { WC_GEARBOX_IMAGE_OFFSET_SHIFT_ONCOMING, 64u, 255u },  /* gearbox.shift.oncoming (uint8_t) */
+    { WC_GEARBOX_IMAGE_OFFSET_SHIFT_OFFGOING, 64u, 255u },  /* gearbox.shift.offgoing (uint8_t) */
 };
 
 typedef struct {

@@ -49,8 +49,18 @@ extern const wc_gearbox_image_rows_t wc_gearbox_image_shift_rows[WC_GEARBOX_IMAG
 /* Every field of gearbox into payload (WC_GEARBOX_IMAGE_PAYLOAD_BYTES), as the struct holds it. */
 void wc_gearbox_image_layout_encode(const wc_gearbox_t *gearbox, uint8_t *payload);
 
+/* A narrow member (bool, uint8_t): count words from offset, each at most max. */
+typedef struct {
+    uint16_t offset;
+    uint8_t count;
+    uint8_t max;
+} wc_gearbox_image_narrow_t;
+
+#define WC_GEARBOX_IMAGE_NARROW_FIELDS 5u
+extern const wc_gearbox_image_narrow_t wc_gearbox_image_narrow[WC_GEARBOX_IMAGE_NARROW_FIELDS];
+
 /* Every field of payload into gearbox, unchecked: the narrow members (bool, uint8_t) take the
- * low bits, so the caller compares the re-encoded payload before it uses gearbox. */
+ * low bits, so the caller checks wc_gearbox_image_narrow's words before it decodes. */
 void wc_gearbox_image_layout_decode(const uint8_t *payload, wc_gearbox_t *gearbox);
 
 /* The name (gearbox_image.py) of the field holding payload byte offset; NULL past the payload. */

@@ -56,7 +56,8 @@ class GearboxImageError(ValueError):
 class Field:
     """One field of wc_gearbox_t: name (A2L), member (C, with {0} {1} the indices over dims), wire type
     ("f32", "u32"), dims (bound names), C type where narrower (uint8_t, bool), unit, closed limits of each
-    value, description; offset set by the order."""
+    value (the A2L's: they include the 0 of an unused row; wc_gearbox_check's ranges for the rows in use are
+    in the description), description; offset set by the order."""
     name: str
     member: str
     ctype: str
@@ -92,10 +93,10 @@ _FIELDS = (
     Field("gearbox.holding_torque_per_Nm", "holding_torque_per_Nm[{0}][{1}]", "f32", _GE, "Nm/Nm", -HOLDING_MAX,
           HOLDING_MAX, "torque an element holds per Nm of turbine torque, [gear][element]"),
     Field("gearbox.shift_count", "shift_count", "u32", (), "1", 0, SHIFTS, "shifts in the table"),
-    Field("gearbox.shift.source_gear", "shift[{0}].source_gear", "u32", _S, "1", 1, GEARS - 1,
-          "the shift's current gear", c_type="uint8_t"),
-    Field("gearbox.shift.target_gear", "shift[{0}].target_gear", "u32", _S, "1", 1, GEARS - 1,
-          "the shift's target gear", c_type="uint8_t"),
+    Field("gearbox.shift.source_gear", "shift[{0}].source_gear", "u32", _S, "1", 0, GEARS - 1,
+          "the shift's current gear (1..; 0: no shift in this row)", c_type="uint8_t"),
+    Field("gearbox.shift.target_gear", "shift[{0}].target_gear", "u32", _S, "1", 0, GEARS - 1,
+          "the shift's target gear (1..; 0: no shift in this row)", c_type="uint8_t"),
     Field("gearbox.shift.oncoming", "shift[{0}].oncoming", "u32", _S, "1", 0, ELEMENTS - 1,
           "the element that closes", c_type="uint8_t"),
     Field("gearbox.shift.offgoing", "shift[{0}].offgoing", "u32", _S, "1", 0, ELEMENTS - 1,
@@ -104,18 +105,18 @@ _FIELDS = (
           "element slip a w_t - b w_o: a, [shift][element]"),
     Field("gearbox.shift.slip_b", "shift[{0}].slip[{1}].b", "f32", _SE, "1", -RATIO_MAX, RATIO_MAX,
           "element slip a w_t - b w_o: b, [shift][element]"),
-    Field("gearbox.shift.output_ratio", "shift[{0}].output_ratio", "f32", _S, "1", 0.05, RATIO_MAX,
-          "reduced model: the target gear's ratio b (DESIGN 15)"),
-    Field("gearbox.shift.offgoing_ratio", "shift[{0}].offgoing_ratio", "f32", _S, "1", 0.05, RATIO_MAX,
-          "reduced model: the source gear's ratio b1"),
+    Field("gearbox.shift.output_ratio", "shift[{0}].output_ratio", "f32", _S, "1", 0.0, RATIO_MAX,
+          "reduced model: the target gear's ratio b (DESIGN 15; 0.05.. in a shift's row, 0 in an unused one)"),
+    Field("gearbox.shift.offgoing_ratio", "shift[{0}].offgoing_ratio", "f32", _S, "1", 0.0, RATIO_MAX,
+          "reduced model: the source gear's ratio b1 (0.05..; 0 unused)"),
     Field("gearbox.shift.oncoming_slip_scale", "shift[{0}].oncoming_slip_scale", "f32", _S, "1", -RATIO_MAX,
           RATIO_MAX, "the on-coming element's a (its slip per unit of the controller's)"),
     Field("gearbox.shift.offgoing_slip_scale", "shift[{0}].offgoing_slip_scale", "f32", _S, "1", -RATIO_MAX,
           RATIO_MAX, "the off-going element's a"),
     Field("gearbox.shift.turbine_inertia_kg_m2", "shift[{0}].turbine_inertia_kg_m2", "f32", _S, "kg*m^2",
-          1e-4, 100.0, "reduced model: turbine-side inertia (paper 2, Fig. 1)"),
+          0.0, 100.0, "reduced model: turbine-side inertia (paper 2, Fig. 1; 1e-4.. in a shift's row, 0 unused)"),
     Field("gearbox.shift.output_inertia_kg_m2", "shift[{0}].output_inertia_kg_m2", "f32", _S, "kg*m^2",
-          1e-4, 1e5, "reduced model: output-side inertia with the vehicle"),
+          0.0, 1e5, "reduced model: output-side inertia with the vehicle (1e-4..; 0 unused)"),
     Field("gearbox.shift.jerk_per_torque_rate", "shift[{0}].jerk_per_torque_rate", "f32", _S,
           "(m/s^3)/(Nm/s)", 0.0, 1.0, "output jerk per rate of the controller's torque"),
 )

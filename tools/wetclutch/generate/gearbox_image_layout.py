@@ -32,6 +32,36 @@ def _rows(dim: str) -> list[layout.Field]:
     return [f for f in layout.FIELDS if f.dims and f.dims[0] == dim]
 
 
+def _narrow() -> list[layout.Field]:
+    """The fields whose C member is narrower than the wire's u32 (bool, uint8_t): the loader checks their words."""
+    return [f for f in layout.FIELDS if f.c_type]
+
+
+_NARROW_MAX = {"bool": 1, "uint8_t": 255}
+_C_BYTES = {"bool": 1, "uint8_t": 1, "": 4}
+SHIFT_BYTES = 4 + 4 * (2 * layout.ELEMENTS + 7)   # wc_gearbox_shift_t: four uint8_t, the slip maps, seven floats
+
+
+def _struct_bytes() -> int:
+    """sizeof(wc_gearbox_t) by C's layout rules of its members as the layout lists them (4-byte alignment for
+    u32 and float, 1 for bool and uint8_t; a shift row is SHIFT_BYTES): a member the layout lacks changes it."""
+    size = 0
+    for f in layout.FIELDS:
+        if f.name.startswith("gearbox.shift."):
+            continue
+        elem = _C_BYTES[f.c_type]
+        size = (size + elem - 1) // elem * elem + elem * f.count
+        if f.name == "gearbox.shift_count":
+            size += SHIFT_BYTES * layout.SHIFTS
+    return (size + 3) // 4 * 4
+
+
+# every array is a gear's or a shift's rows (the loader's unused-word rule covers it), its second index an element
+for _f in layout.FIELDS:
+    assert not _f.dims or (_f.dims[0] in ("GEARS", "SHIFTS") and _f.dims[1:] in ((), ("ELEMENTS",))), _f.name
+    assert _f.c_type in _NARROW_MAX or _f.c_type == "", _f.name
+
+
 def header_text() -> str:
     lines = [banner(COMMAND).rstrip("\n"),
              "/* The gearbox image's payload layout (tools/wetclutch/calibration/gearbox_image.py): each field's",
@@ -53,8 +83,13 @@ def header_text() -> str:
               "extern const wc_gearbox_image_rows_t wc_gearbox_image_shift_rows[WC_GEARBOX_IMAGE_SHIFT_FIELDS];", "",
               "/* Every field of gearbox into payload (WC_GEARBOX_IMAGE_PAYLOAD_BYTES), as the struct holds it. */",
               "void wc_gearbox_image_layout_encode(const wc_gearbox_t *gearbox, uint8_t *payload);", "",
+              "/* A narrow member (bool, uint8_t): count words from offset, each at most max. */",
+              "typedef struct {", "    uint16_t offset;", "    uint8_t count;", "    uint8_t max;",
+              "} wc_gearbox_image_narrow_t;", "",
+              f"#define WC_GEARBOX_IMAGE_NARROW_FIELDS {len(_narrow())}u",
+              "extern const wc_gearbox_image_narrow_t wc_gearbox_image_narrow[WC_GEARBOX_IMAGE_NARROW_FIELDS];", "",
               "/* Every field of payload into gearbox, unchecked: the narrow members (bool, uint8_t) take the",
-              " * low bits, so the caller compares the re-encoded payload before it uses gearbox. */",
+              " * low bits, so the caller checks wc_gearbox_image_narrow's words before it decodes. */",
               "void wc_gearbox_image_layout_decode(const uint8_t *payload, wc_gearbox_t *gearbox);", "",
               "/* The name (gearbox_image.py) of the field holding payload byte offset; NULL past the payload. */",
               "const char *wc_gearbox_image_field_name(uint32_t offset);", "",
@@ -121,8 +156,8 @@ def source_text() -> str:
              f"WC_STATIC_ASSERT(WC_GEARBOX_ELEMENTS_MAX == {layout.ELEMENTS}u, elements_as_the_layout);",
              f"WC_STATIC_ASSERT(WC_GEARBOX_GEARS_MAX == {layout.GEARS}u, gears_as_the_layout);",
              f"WC_STATIC_ASSERT(WC_GEARBOX_SHIFTS_MAX == {layout.SHIFTS}u, shifts_as_the_layout);",
-             f"WC_STATIC_ASSERT(sizeof(wc_gearbox_shift_t) == {4 + 4 * (2 * layout.ELEMENTS + 7)}u,"
-             " every_shift_field_in_the_layout);", "",
+             f"WC_STATIC_ASSERT(sizeof(wc_gearbox_shift_t) == {SHIFT_BYTES}u, every_shift_field_in_the_layout);",
+             f"WC_STATIC_ASSERT(sizeof(wc_gearbox_t) == {_struct_bytes()}u, every_gearbox_field_in_the_layout);", "",
              "void wc_gearbox_image_layout_encode(const wc_gearbox_t *gearbox, uint8_t *payload)", "{",
              *_body(_put), "}", "",
              "void wc_gearbox_image_layout_decode(const uint8_t *payload, wc_gearbox_t *gearbox)", "{",
@@ -131,6 +166,9 @@ def source_text() -> str:
              *_row_table("GEARS"), "};", "",
              "const wc_gearbox_image_rows_t wc_gearbox_image_shift_rows[WC_GEARBOX_IMAGE_SHIFT_FIELDS] = {",
              *_row_table("SHIFTS"), "};", "",
+             "const wc_gearbox_image_narrow_t wc_gearbox_image_narrow[WC_GEARBOX_IMAGE_NARROW_FIELDS] = {",
+             *(f"    {{ {macro(f)}, {f.count}u, {_NARROW_MAX[f.c_type]}u }},  /* {f.name} ({f.c_type}) */"
+               for f in _narrow()), "};", "",
              *field_name_lookup("wc_gearbox_image_field_name", ((macro(f), f.bytes, f.name) for f in layout.FIELDS))]
     return "\n".join(lines) + "\n"
 
