@@ -111,12 +111,14 @@ for level in "${levels[@]}"; do
     case $lib in
       model) archive=$build/wetclutch/src/model/libwetclutch.a ;;
       can) archive=$build/wetclutch/src/can/libwetclutch_can.a ;;
-      xcp|isotp|uds|dtc) archive=$build/wetclutch/src/can/libwetclutch_can.a; member=wc_$lib.c.obj ;;
+      isotp|uds|dtc) archive=$build/wetclutch/src/can/libwetclutch_can.a; member="^wc_${lib}[.]c[.]obj$" ;;
+      xcp) archive=$build/wetclutch/src/can/libwetclutch_can.a; member='^wc_xcp(_memory)?[.]c[.]obj$' ;;  # its two files
       cal) archive=$build/libwc_arm_calibration.a ;;
     esac
     t=
     if [ -n "$member" ]; then  # one object of the archive
-      read -r t d b < <(${prefix}size "$archive" | awk -v m="$member" '$6 == m { print $1, $2, $3 }') || true
+      read -r t d b < <(${prefix}size "$archive" | awk -v m="$member" '$6 ~ m { t += $1; d += $2; b += $3; n++ }
+                                                           END { if (n) print t, d, b }') || true
     else
       read -r t d b < <(${prefix}size -t "$archive" | awk 'END { print $1, $2, $3 }')
     fi
@@ -243,7 +245,7 @@ qemu_version=$(qemu-system-arm --version | awk 'NR == 1 { print $4 }')
     case $lib in
       model) label='model, `libwetclutch.a`' ;;
       can) label='CAN layer, `libwetclutch_can.a`' ;;
-      xcp) label='of which the XCP slave, `wc_xcp.c`' ;;
+      xcp) label='of which the XCP slave, `wc_xcp.c` + `wc_xcp_memory.c`' ;;
       isotp) label='of which ISO-TP, `wc_isotp.c`' ;;
       uds) label='of which the UDS server, `wc_uds.c`' ;;
       dtc) label='of which the fault memory, `wc_dtc.c`' ;;

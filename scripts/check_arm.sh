@@ -229,8 +229,9 @@ read -r base_text base_data base_bss < <(sizes "$work/baseline.elf")
 read -r xfw_text xfw_data xfw_bss < <(sizes "$work/firmware_xcp.elf")
 # The XCP slave: its object in the CAN layer, and the firmware with it minus the one without
 # (of which the table1 image, its reference page, in .wc_calibration).
-read -r xcp_text xcp_data xcp_bss < <(${prefix}size "$can_lib" | awk '$6 == "wc_xcp.c.obj" { print $1, $2, $3 }')
-[ -n "${xcp_text:-}" ] || { echo "check_arm: FAIL: no wc_xcp.c.obj in $can_lib" >&2; exit 1; }
+read -r xcp_text xcp_data xcp_bss < <(${prefix}size "$can_lib" | awk '$6 == "wc_xcp.c.obj" || $6 == "wc_xcp_memory.c.obj" {
+  t += $1; d += $2; b += $3; n++ } END { if (n == 2) print t, d, b }')
+[ -n "${xcp_text:-}" ] || { echo "check_arm: FAIL: no wc_xcp.c.obj and wc_xcp_memory.c.obj in $can_lib" >&2; exit 1; }
 xcp_flash=$(((xfw_text + xfw_data) - (fw_text + fw_data)))
 xcp_ram=$(((xfw_data + xfw_bss) - (fw_data + fw_bss)))
 xcp_image=$(${prefix}size -A "$work/firmware_xcp.elf" | awk '$1 == ".wc_calibration" { print $2 }')

@@ -62,7 +62,13 @@
  *   gearbox at gearbox_base: the gearbox image's payload (wc_gearbox_image.h)
  *       of the transmission the TCU runs (read only: a gearbox is flashed,
  *       not tuned while it drives); wc_xcp_set_gearbox gives it, and
- *       without one the region answers ERR_ACCESS_DENIED.
+ *       without one the region answers ERR_ACCESS_DENIED;
+ *   element e (0 .. WC_GEARBOX_ELEMENTS_MAX - 1) at element_base +
+ *       e WC_XCP_ELEMENT_STRIDE: that element's calibration image payload
+ *       (wc_cal_image.h: its clutch; shift control off), read only, given
+ *       by wc_xcp_set_element (else ERR_ACCESS_DENIED). Online calibration
+ *       of a running transmission's elements is not there
+ *       (wc_loop_recalibrate refuses a transmission).
  * On a 64-bit host the bases are offsets the slave reports (wc_xcp_init's
  * config, printed by wc_tcu --xcp-layout); on a 32-bit target they may be
  * the objects' addresses. The A2L (tools/wetclutch/generate/a2l.py) takes
@@ -108,6 +114,7 @@
 #include "wc_cal_image.h"
 #include "wc_can_frame.h"
 #include "wc_loop.h"
+#include <wetclutch/wc_gearbox.h>
 
 #define WC_XCP_RX_CAPACITY 4u            /* command frames buffered between two steps (power of two) */
 #define WC_XCP_DAQ_LISTS 4u              /* dynamic DAQ lists */
@@ -180,7 +187,10 @@ typedef struct {
     uint32_t unlock_attempts;     /* 1..255 wrong keys in a row until the lock-out (with the hooks) */
     uint32_t unlock_delay_steps;  /* the lock-out, 1..WC_XCP_UNLOCK_DELAY_MAX_STEPS control steps (with the hooks) */
     uint32_t gearbox_base;        /* the gearbox region's base (wc_xcp_set_gearbox; last: added with issue 29) */
+    uint32_t element_base;        /* element 0's region (wc_xcp_set_element), element e WC_XCP_ELEMENT_STRIDE on */
 } wc_xcp_config_t;
+
+#define WC_XCP_ELEMENT_STRIDE 0x00010000u
 
 #define WC_XCP_UNLOCK_DELAY_MAX_STEPS 0x7FFFFFFFu
 
@@ -188,7 +198,7 @@ typedef struct {
  * GET_SEED out for 10000 control steps (10 s at the 1 ms period), as UDS SecurityAccess's default (wc_uds.h). */
 #define WC_XCP_CONFIG_DEFAULT                                                                          \
     { 0x00010000u, 0x00100000u, 0x00200000u, 0x00300000u, "wetclutch TCU", "wetclutch", false, 6u, 6u, \
-      NULL, NULL, NULL, 3u, 10000u, 0x00400000u }
+      NULL, NULL, NULL, 3u, 10000u, 0x00400000u, 0x00500000u }
 
 /* What the master can read of the slave (UPLOAD, DAQ): the counters and the
  * last page check. */
@@ -231,6 +241,7 @@ typedef struct {
     wc_loop_t *loop;
     const uint8_t *reference_page;  /* the image's payload the TCU started from (flash) */
     const uint8_t *gearbox_page;    /* the gearbox image's payload (flash); NULL: no gearbox region */
+    const uint8_t *element_page[WC_GEARBOX_ELEMENTS_MAX];  /* each element's calibration payload; NULL: none */
     uint8_t working_page[WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
     wc_cal_set_t sets[2];           /* the decoded working page: the one the loop uses, the next */
     int32_t loop_set;               /* index of sets the loop uses; -1: the integrator's own */
@@ -291,9 +302,14 @@ uint32_t wc_xcp_step(wc_xcp_t *xcp, bool control_step, wc_can_frame_t out[WC_XCP
  * they must outlive the slave). */
 void wc_xcp_set_gearbox(wc_xcp_t *xcp, const uint8_t *gearbox_payload);
 
+/* Element e's region: its calibration image payload (wc_cal_image_payload_bytes bytes, the element's clutch
+ * as wc_cal_image_encode writes it), which must outlive the slave; NULL: denied again; e out of range: nothing. */
+void wc_xcp_set_element(wc_xcp_t *xcp, uint32_t element, const uint8_t *element_payload);
+
 /* The memory regions (for the A2L and wc_tcu --xcp-layout): index 0 cal,
- * 1 loop, 2 status, 3 id, 4 gearbox. */
-#define WC_XCP_REGIONS 5u
+ * 1 loop, 2 status, 3 id, 4 gearbox, then WC_XCP_FIRST_ELEMENT_REGION + e element e. */
+#define WC_XCP_FIRST_ELEMENT_REGION 5u
+#define WC_XCP_REGIONS (WC_XCP_FIRST_ELEMENT_REGION + WC_GEARBOX_ELEMENTS_MAX)
 void wc_xcp_regions(const wc_xcp_t *xcp, wc_xcp_region_t regions[WC_XCP_REGIONS]);
 
 #endif /* WC_XCP_H */

@@ -5,10 +5,9 @@
 
 #include <string.h>
 
+#include "wc_xcp_internal.h"
 #include "wetclutch/wetclutch.h"
-#include "wetclutch_can/wc_gearbox_image.h"
 
-#define XCP_OK 0x100u               /* a handler's positive result (error codes are < 0x100) */
 #define MAX_CTO 8u
 #define MAX_DTO 8u
 #define UPLOAD_MAX (MAX_CTO - 1u)   /* bytes a positive response carries */
@@ -90,47 +89,6 @@ static uint32_t text_length(const char *text, uint32_t capacity)
     uint32_t n = 0u;
     while ((n < capacity) && (text[n] != '\0')) { ++n; }
     return n;
-}
-
-void wc_xcp_regions(const wc_xcp_t *xcp, wc_xcp_region_t regions[WC_XCP_REGIONS])
-{
-    WC_ASSERT((xcp != NULL) && (regions != NULL));
-    if ((xcp == NULL) || (regions == NULL)) { return; }
-    regions[0] = (wc_xcp_region_t){ xcp->config.cal_base, wc_cal_image_payload_bytes };
-    regions[1] = (wc_xcp_region_t){ xcp->config.loop_base, (uint32_t)sizeof(wc_loop_t) };
-    regions[2] = (wc_xcp_region_t){ xcp->config.status_base, (uint32_t)sizeof(wc_xcp_status_t) };
-    regions[3] = (wc_xcp_region_t){ xcp->config.id_base, WC_XCP_ID_BYTES };
-    regions[4] = (wc_xcp_region_t){ xcp->config.gearbox_base, wc_gearbox_image_payload_bytes };
-}
-
-void wc_xcp_set_gearbox(wc_xcp_t *xcp, const uint8_t *gearbox_payload)
-{
-    WC_ASSERT(xcp != NULL);
-    if (xcp != NULL) { xcp->gearbox_page = gearbox_payload; }
-}
-
-/* The bytes at [address, address + length) when they lie inside one
- * region: *bytes points at them. write: the working page only, and only
- * while the XCP page is the working page. Returns XCP_OK or the error. */
-static uint32_t resolve(wc_xcp_t *x, uint32_t address, uint32_t extension, uint32_t length, bool write,
-                        uint8_t **bytes)
-{
-    if (extension != 0u) { return WC_XCP_ERR_ACCESS_DENIED; }
-    wc_xcp_region_t regions[WC_XCP_REGIONS];
-    wc_xcp_regions(x, regions);
-    uint8_t *const base[WC_XCP_REGIONS] = {  /* cppcheck-suppress constVariable ; written through (DOWNLOAD) */
-        (x->xcp_page == 0u) ? x->working_page : (uint8_t *)(uintptr_t)x->reference_page,
-        (uint8_t *)x->loop, (uint8_t *)&x->status, (uint8_t *)x->id, (uint8_t *)(uintptr_t)x->gearbox_page };
-    for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
-        const uint32_t offset = address - regions[r].base;  /* wraps for an address below the base */
-        if ((address >= regions[r].base) && (offset <= regions[r].size) && (length <= regions[r].size - offset)) {
-            if (base[r] == NULL) { return WC_XCP_ERR_ACCESS_DENIED; }  /* no gearbox given */
-            if (write && ((r != 0u) || (x->xcp_page != 0u))) { return WC_XCP_ERR_WRITE_PROTECTED; }
-            *bytes = base[r] + offset;
-            return XCP_OK;
-        }
-    }
-    return WC_XCP_ERR_ACCESS_DENIED;
 }
 
 /* The resources seed & key protects under config (both hooks set). */
@@ -283,7 +241,7 @@ static uint32_t write_daq(wc_xcp_t *x, const uint8_t *cmd)
     const uint32_t size = cmd[2];
     if ((bit_offset != 0xFFu) || (size == 0u) || (size > ODT_PAYLOAD)) { return WC_XCP_ERR_OUT_OF_RANGE; }
     uint8_t *src = NULL;
-    const uint32_t found = resolve(x, wc_image_get_u32(&cmd[4]), cmd[3], size, false, &src);
+    const uint32_t found = wc_xcp_resolve(x, wc_image_get_u32(&cmd[4]), cmd[3], size, false, &src);
     if (found != XCP_OK) { return found; }
     const wc_xcp_odt_t *o = &x->odts[x->lists[x->ptr_list].first_odt + x->ptr_odt];
     /* the ODT's bytes with this entry in place of the old one fit one frame */
@@ -479,7 +437,7 @@ static uint32_t upload(wc_xcp_t *x, uint32_t address, uint32_t extension, uint32
 {
     if ((length == 0u) || (length > UPLOAD_MAX)) { return WC_XCP_ERR_OUT_OF_RANGE; }
     uint8_t *src = NULL;
-    const uint32_t found = resolve(x, address, extension, length, false, &src);
+    const uint32_t found = wc_xcp_resolve(x, address, extension, length, false, &src);
     if (found != XCP_OK) { return found; }
     copy_bytes(&res[1], src, length);
     x->mta = address + length;
@@ -493,7 +451,7 @@ static uint32_t download(wc_xcp_t *x, const uint8_t *cmd, uint32_t dlc)
     if ((length == 0u) || (length > DOWNLOAD_MAX)) { return WC_XCP_ERR_OUT_OF_RANGE; }
     if (dlc < 2u + length) { return WC_XCP_ERR_CMD_SYNTAX; }
     uint8_t *dst = NULL;
-    const uint32_t found = resolve(x, x->mta, 0u, length, true, &dst);
+    const uint32_t found = wc_xcp_resolve(x, x->mta, 0u, length, true, &dst);
     if (found != XCP_OK) { return found; }
     const bool changed = write_bytes(dst, &cmd[2], length);
     /* a page the controller does not use is checked when SET_CAL_PAGE switches to it */
@@ -511,7 +469,7 @@ static uint32_t build_checksum(wc_xcp_t *x, const uint8_t *cmd, uint8_t *res)
         return WC_XCP_ERR_OUT_OF_RANGE;
     }
     uint8_t *src = NULL;
-    const uint32_t found = resolve(x, x->mta, 0u, length, false, &src);
+    const uint32_t found = wc_xcp_resolve(x, x->mta, 0u, length, false, &src);
     if (found != XCP_OK) { return found; }
     res[1] = 0x09u;  /* XCP_CRC_32: IEEE 802.3, as wc_image_crc32 */
     wc_image_put_u32(&res[4], wc_image_crc32(src, length));

@@ -184,7 +184,9 @@ static void print_xcp_layout(void)
     xcp.config = (wc_xcp_config_t)WC_XCP_CONFIG_DEFAULT;
     wc_xcp_region_t regions[WC_XCP_REGIONS];
     wc_xcp_regions(&xcp, regions);
-    static const char *const region_names[WC_XCP_REGIONS] = {"cal", "loop", "xcp", "id", "gearbox"};
+    static const char *const region_names[WC_XCP_REGIONS] = {"cal", "loop", "xcp", "id", "gearbox", "element0",
+                                                              "element1", "element2", "element3", "element4",
+                                                              "element5"};
     printf("{\n  \"program\": \"wc_tcu\",\n  \"regions\": {");
     for (uint32_t r = 0u; r < WC_XCP_REGIONS; ++r) {
         printf("%s\"%s\": {\"base\": %u, \"size\": %u}", r ? ", " : "", region_names[r], regions[r].base,
@@ -387,6 +389,18 @@ static int start_xcp(wc_xcp_t *xcp, wc_loop_t *loop, const wc_calibration_t *cal
             return -1;
         }
         wc_xcp_set_gearbox(xcp, &gearbox_image[WC_IMAGE_HEADER_BYTES]);
+        /* each element's region: its clutch as a calibration payload (shift control off) */
+        static wc_cal_set_t element_set;
+        static uint8_t element_payload[WC_GEARBOX_ELEMENTS_MAX][WC_CAL_IMAGE_PAYLOAD_MAX_BYTES];
+        for (uint32_t e = 0u; e < config->transmission->gearbox->element_count; ++e) {
+            if (!wc_cal_set_from(&element_set, config->transmission->element[e], NULL, NULL)) {
+                fprintf(stderr, "wc_tcu: --xcp: element %u's calibration does not fit a calibration page\n",
+                        (unsigned)e);
+                return -1;
+            }
+            wc_cal_image_encode(&element_set, element_payload[e]);
+            wc_xcp_set_element(xcp, e, element_payload[e]);
+        }
     }
     return 0;
 }

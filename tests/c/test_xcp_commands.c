@@ -218,7 +218,7 @@ static void test_command_errors(void **state)
     wc_xcp_regions(&rig.xcp, regions);
     assert_int_equal(regions[0].size, PAYLOAD);
     assert_int_equal(regions[1].size, sizeof(wc_loop_t));
-    for (uint32_t r = 0u; r < WC_XCP_REGIONS - 1u; ++r) {  /* the gearbox region (none given here): below */
+    for (uint32_t r = 0u; r < 4u; ++r) {  /* the gearbox's and the elements' regions (none given here): below */
         const uint32_t end = regions[r].base + regions[r].size;
         EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(end - 3u)), WC_XCP_ERR_ACCESS_DENIED);
         EXPECT_OK(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(end - 4u)));
@@ -272,6 +272,34 @@ static void test_gearbox_region(void **state)
     EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(base)), WC_XCP_ERR_ACCESS_DENIED);
 }
 
+/* Each element's region: its calibration payload, read only; without one, or past the elements, denied. */
+static void test_element_regions(void **state)
+{
+    (void)state;
+    static uint8_t uploaded[PAYLOAD];
+    const uint32_t element2 = xcp_config.element_base + 2u * WC_XCP_ELEMENT_STRIDE;
+    connect();
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(element2)), WC_XCP_ERR_ACCESS_DENIED);
+    wc_xcp_set_element(&rig.xcp, 2u, rig.reference);           /* a calibration payload stands for the element's */
+    wc_xcp_set_element(&rig.xcp, WC_GEARBOX_ELEMENTS_MAX, rig.reference);   /* no such element: nothing */
+    wc_xcp_region_t regions[WC_XCP_REGIONS];
+    wc_xcp_regions(&rig.xcp, regions);
+    assert_int_equal(regions[WC_XCP_FIRST_ELEMENT_REGION + 2u].base, element2);
+    assert_int_equal(regions[WC_XCP_FIRST_ELEMENT_REGION + 2u].size, PAYLOAD);
+    upload(element2, uploaded, PAYLOAD);
+    assert_memory_equal(uploaded, rig.reference, PAYLOAD);
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 1, 0, 0, U32(element2 + PAYLOAD)), WC_XCP_ERR_ACCESS_DENIED);
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 1, 0, 0, U32(element2 - WC_XCP_ELEMENT_STRIDE)), WC_XCP_ERR_ACCESS_DENIED);
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 1, 0, 0,
+                   U32(xcp_config.element_base + WC_GEARBOX_ELEMENTS_MAX * WC_XCP_ELEMENT_STRIDE)),
+               WC_XCP_ERR_ACCESS_DENIED);
+    set_mta(element2);
+    EXPECT_ERR(download_n(BYTES(0, 0, 0, 0), 4u, 1u), WC_XCP_ERR_WRITE_PROTECTED);
+    assert_memory_equal(uploaded, rig.reference, PAYLOAD);
+    wc_xcp_set_element(&rig.xcp, 2u, NULL);
+    EXPECT_ERR(CMD(WC_XCP_SHORT_UPLOAD, 4, 0, 0, U32(element2)), WC_XCP_ERR_ACCESS_DENIED);
+}
+
 static void test_frames_without_answer(void **state)
 {
     (void)state;
@@ -321,6 +349,7 @@ int main(void)
         cmocka_unit_test_setup(test_calibration_page_commands, setup),
         cmocka_unit_test_setup(test_command_errors, setup),
         cmocka_unit_test_setup(test_gearbox_region, setup),
+        cmocka_unit_test_setup(test_element_regions, setup),
         cmocka_unit_test_setup(test_frames_without_answer, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

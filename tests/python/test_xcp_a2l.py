@@ -38,7 +38,7 @@ def test_program_layout_matches_the_sources(layout):
     bases = sorted(r["base"] for r in layout["regions"].values())
     spans = sorted((r["base"], r["base"] + r["size"]) for r in layout["regions"].values())
     assert all(a[1] <= b[0] for a, b in zip(spans, spans[1:])), "regions overlap"
-    assert len(set(bases)) == 5
+    assert len(set(bases)) == 5 + a2l.ELEMENTS
     assert layout["regions"]["gearbox"]["size"] == gearbox_image.payload_bytes()
 
 
@@ -47,7 +47,9 @@ def test_every_characteristic_at_its_layout_offset(layout, parsed):
     chars = desc["characteristics"]
     base = layout["regions"]["cal"]["base"]
     gearbox_base = layout["regions"]["gearbox"]["base"]
-    assert set(chars) == {f.name for f in image_layout.FIELDS} | {f.name for f in gearbox_image.FIELDS}
+    element_names = {f"element{e}.{f.name}" for e in range(a2l.ELEMENTS) for f in image_layout.FIELDS
+                     if f.group == "clutch"}
+    assert set(chars) == {f.name for f in image_layout.FIELDS} | {f.name for f in gearbox_image.FIELDS} | element_names
     for f in image_layout.FIELDS:
         address, deposit, kind = chars[f.name]
         assert address == base + f.offset, f.name
@@ -58,6 +60,12 @@ def test_every_characteristic_at_its_layout_offset(layout, parsed):
         assert address == gearbox_base + f.offset, f.name
         assert deposit == a2l.A2L_TYPES[f.ctype][1], f.name
         assert kind == ("VAL_BLK" if f.dims else "VALUE"), f.name
+    for e in range(a2l.ELEMENTS):    # each element's clutch: its calibration payload's clutch fields
+        element_base = layout["regions"][f"element{e}"]["base"]
+        assert layout["regions"][f"element{e}"]["size"] == image_layout.payload_bytes()
+        for f in image_layout.FIELDS:
+            if f.group == "clutch":
+                assert chars[f"element{e}.{f.name}"][0] == element_base + f.offset, (e, f.name)
 
 
 def test_gearbox_characteristics_are_read_only_tables(parsed):
@@ -86,9 +94,8 @@ def test_gearbox_characteristics_are_read_only_tables(parsed):
     # lut/wc_8hp_gearbox.h's second row, 1-3 (E on, A off): slip a of A -0.811765, of D 1.34725, of E 0.905882
     assert slip_a[1, 0] == pytest.approx(-0.811765, rel=1e-6) and slip_a[1, 3] == pytest.approx(1.34725, rel=1e-6)
     assert slip_a[1, 4] == pytest.approx(0.905882, rel=1e-6) and slip_a[1, 1] == 0.0
-    for c in chars.values():
-        if not c.name.startswith("gearbox."):
-            assert c.read_only is False, c.name
+    for c in chars.values():   # read only: the gearbox and the elements; the calibration page is written
+        assert c.read_only is c.name.startswith(("gearbox.", "element")), c.name
 
 
 def test_every_measurement_at_the_programs_address(layout, parsed):
@@ -118,7 +125,8 @@ def test_units_and_limits_from_the_sources(parsed):
     session = pya2l.import_a2l(str(path), in_memory=True, progress_bar=False, loglevel="ERROR")
     units = {c.name: c.unit for c in session.query(model.CompuMethod).all()}
     for c in session.query(model.Characteristic).all():
-        f = image_layout.BY_NAME.get(c.name) or gearbox_image.BY_NAME[c.name]
+        name = c.name.split(".", 1)[1] if c.name.startswith("element") else c.name   # element3.clutch.mu1
+        f = image_layout.BY_NAME.get(name) or gearbox_image.BY_NAME[name]
         assert units[c.conversion] == f.unit, c.name
         # the A2L writes the float's repr: the limit exactly
         assert (c.lowerLimit, c.upperLimit) == (pytest.approx(f.lower, rel=0), pytest.approx(f.upper, rel=0)), c.name

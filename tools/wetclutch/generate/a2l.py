@@ -21,7 +21,8 @@ from ..calibration.measurements import SIGNALS, TYPES
 from ..util.atomic import Staged
 
 A2L_TYPES = {"f32": ("FLOAT32_IEEE", "RL_F32"), "u32": ("ULONG", "RL_U32")}
-REGION_KEYS = ("cal", "loop", "xcp", "id", "gearbox")
+ELEMENTS = 6                 # WC_GEARBOX_ELEMENTS_MAX: the elements' regions element0 .. element5
+REGION_KEYS = ("cal", "loop", "xcp", "id", "gearbox", *(f"element{e}" for e in range(ELEMENTS)))
 
 
 class A2lError(RuntimeError):
@@ -61,6 +62,10 @@ def _check(layout: dict) -> None:
     if regions["gearbox"][1] != gearbox_image.payload_bytes():
         raise A2lError(f"the program's gearbox region has {regions['gearbox'][1]} bytes, the gearbox image layout"
                        f" {gearbox_image.payload_bytes()}: rebuild the program or regenerate the layout")
+    for e in range(ELEMENTS):
+        if regions[f"element{e}"][1] != image_layout.payload_bytes():
+            raise A2lError(f"the program's element{e} region has {regions[f'element{e}'][1]} bytes, the image layout"
+                           f" {image_layout.payload_bytes()}: rebuild the program or regenerate the layout")
     for s in SIGNALS:
         if s.name not in signals:
             raise A2lError(f"the program does not know the signal {s.name}: regenerate src/port/wc_xcp_signals.c")
@@ -109,7 +114,10 @@ def a2l_text(layout: dict) -> str:
                 ("loop", "the frame loop's state (wc_loop_t), read only", "VARIABLES", "RAM", "loop"),
                 ("xcp_status", "the XCP slave's status (wc_xcp_status_t), read only", "VARIABLES", "RAM", "xcp"),
                 ("gearbox", "the gearbox image's payload (wc_gearbox_image.h) of the transmission the TCU runs, read"
-                 " only; without one ERR_ACCESS_DENIED", "DATA", "FLASH", "gearbox"))
+                 " only; without one ERR_ACCESS_DENIED", "DATA", "FLASH", "gearbox"),
+                *((f"element{e}", f"element {e}'s calibration image payload (its clutch) of the transmission the TCU"
+                   " runs, read only; without one ERR_ACCESS_DENIED", "DATA", "FLASH", f"element{e}")
+                  for e in range(ELEMENTS)))
     for name, text, prg, mem, key in segments:
         base, size = regions[key]
         out.append(f"      /begin MEMORY_SEGMENT {name} {_string(text)} {prg} {mem} INTERN 0x{base:08X} {size}"
@@ -140,6 +148,18 @@ def a2l_text(layout: dict) -> str:
             lines.append("      MATRIX_DIM " + " ".join(str(gearbox_image.BOUNDS[d]) for d in f.dims))
         lines.append("    /end CHARACTERISTIC")
         out.extend(lines)
+    element_fields = [f for f in fields if f.group == "clutch"]   # an element image's: its clutch (shift off)
+    for e in range(ELEMENTS):
+        base = regions[f"element{e}"][0]
+        for f in element_fields:
+            kind = "VALUE" if f.count == 1 else "VAL_BLK"
+            lines = [f"    /begin CHARACTERISTIC element{e}.{f.name} {_string(f'element {e}: ' + f.description)} {kind}"
+                     f" 0x{base + f.offset:08X} {A2L_TYPES[f.ctype][1]} 0 {_compu_method(f.unit)} {_number(f.lower)}"
+                     f" {_number(f.upper)}", "      READ_ONLY"]
+            if f.count > 1:
+                lines.append(f"      MATRIX_DIM {f.count}")
+            lines.append("    /end CHARACTERISTIC")
+            out.extend(lines)
     for s in SIGNALS:
         address = regions[s.region][0] + offsets[s.name]
         out.append(f"    /begin MEASUREMENT {s.name} {_string(s.description)} {TYPES[s.ctype][0]}"
@@ -153,6 +173,10 @@ def a2l_text(layout: dict) -> str:
                    " /end REF_CHARACTERISTIC /end GROUP")
     out.append('    /begin GROUP gearbox "the gearbox (wc_gearbox_t), read only" ROOT /begin REF_CHARACTERISTIC '
                + " ".join(f.name for f in gearbox_image.FIELDS) + " /end REF_CHARACTERISTIC /end GROUP")
+    for e in range(ELEMENTS):
+        out.append(f'    /begin GROUP element{e} "element {e}\'s clutch (wc_calibration_t), read only" ROOT'
+                   " /begin REF_CHARACTERISTIC " + " ".join(f"element{e}.{f.name}" for f in element_fields)
+                   + " /end REF_CHARACTERISTIC /end GROUP")
     out.append('    /begin GROUP measurements "measured signals" ROOT /begin REF_MEASUREMENT '
                + " ".join(s.name for s in SIGNALS) + " /end REF_MEASUREMENT /end GROUP")
     out += ["  /end MODULE", "/end PROJECT", ""]
