@@ -237,7 +237,7 @@ int main(int argc, char **argv)
                             " --shift or --set\n");
             return 2;
         }
-        if (wc_cal_image_file_load(image_path, "wc_replay", &image) != 0) { return 2; }
+        if (wc_cal_image_file_load(image_path, "wc_replay", "--calibration-image", &image) != 0) { return 2; }
         cal = &image.clutch;
         config = image.loop;
         calibration = image_path;
@@ -271,7 +271,7 @@ int main(int argc, char **argv)
                             " whole shift): --shift NAME or an image with it\n");
             return 2;
         }
-        if (wc_cal_image_file_load(offgoing_image_path, "wc_replay", &offgoing_image) != 0) { return 2; }
+        if (wc_cal_image_file_load(offgoing_image_path, "wc_replay", "--offgoing-calibration-image", &offgoing_image) != 0) { return 2; }
         if (offgoing_image.shift_enabled) {
             fprintf(stderr, "wc_replay: --offgoing-calibration-image %s: carries shift control; the off-going"
                             " clutch's image holds its clutch alone (shift off)\n", offgoing_image_path);

@@ -35,17 +35,17 @@ static void refused(const char *program, const char *option, const char *path, c
             (field[0] != '\0') ? " (" : "", field, (field[0] != '\0') ? ")" : "", length);
 }
 
-int wc_cal_image_file_load(const char *path, const char *program, wc_cal_set_t *set)
+int wc_cal_image_file_load(const char *path, const char *program, const char *option, wc_cal_set_t *set)
 {
     static uint8_t image[WC_CAL_IMAGE_FILE_MAX_BYTES];
     size_t length = 0u;
-    if (wc_image_file_read(path, program, "--calibration-image", image, sizeof image, &length) != 0) {
+    if (wc_image_file_read(path, program, option, image, sizeof image, &length) != 0) {
         (void)wc_cal_image_load(NULL, 0u, set);
         return -1;
     }
     const wc_cal_image_status_t status = wc_cal_image_load(image, length, set);
     if (status.result != (uint32_t)WC_CAL_IMAGE_OK) {
-        refused(program, "--calibration-image", path, wc_cal_image_result_name(status.result),
+        refused(program, option, path, wc_cal_image_result_name(status.result),
                 wc_cal_image_error_name(status), length);
         return -1;
     }

@@ -22,9 +22,10 @@ int wc_image_file_read(const char *path, const char *program, const char *option
 
 /* Reads path and loads it into set (wc_cal_image_load). Returns 0 when the
  * image is used; otherwise -1, set zeroed, after one line on stderr,
- * "PROGRAM: --calibration-image PATH: ..." naming the OS error or the
+ * "PROGRAM: OPTION PATH: ..." (option: the one that named the file,
+ * "--calibration-image", "--element-image", ...) naming the OS error or the
  * image's result and field ("BAD_SHIFT (shift.kp_Nm_per_rad_s)"). */
-int wc_cal_image_file_load(const char *path, const char *program, wc_cal_set_t *set);
+int wc_cal_image_file_load(const char *path, const char *program, const char *option, wc_cal_set_t *set);
 
 /* The same for a gearbox image (wc_gearbox_image_load; --gearbox-image):
  * 0, or -1 with gearbox zeroed after one line naming the OS error or the

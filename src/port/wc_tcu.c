@@ -592,7 +592,7 @@ int main(int argc, char **argv)
     wc_loop_config_t config = WC_LOOP_CONFIG_DEFAULT;
     const wc_calibration_t *cal = NULL;
     if (opt.calibration_image != NULL) {  /* the whole calibration from the image, or not started */
-        if (wc_cal_image_file_load(opt.calibration_image, "wc_tcu", &image) != 0) { return 2; }
+        if (wc_cal_image_file_load(opt.calibration_image, "wc_tcu", "--calibration-image", &image) != 0) { return 2; }
         cal = &image.clutch;
         config = image.loop;
         opt.calibration = opt.calibration_image;

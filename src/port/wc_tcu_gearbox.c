@@ -99,7 +99,7 @@ int wc_tcu_gearbox_config(const char *program, const wc_tcu_gearbox_options_t *o
     for (size_t e = 0u; e < gearbox->element_count; ++e) {
         tx->element[e] = cal;
         if (o->element_images == 0u) { continue; }
-        if (wc_cal_image_file_load(o->element_image[e], program, &images[e]) != 0) { return 2; }
+        if (wc_cal_image_file_load(o->element_image[e], program, "--element-image", &images[e]) != 0) { return 2; }
         tx->element[e] = &images[e].clutch;
     }
     tx->shift = config->shift;

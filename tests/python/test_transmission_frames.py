@@ -157,6 +157,8 @@ BAD_GEARBOX_OPTIONS = [
     (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--start-gear", "9"], "start gear 6"),
     (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--element-image", "/nonexistent.img"], "5 elements"),
     (["--element-image", "/nonexistent.img"], "needs --gearbox"),
+    (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", *["--element-image", "/nonexistent.img"] * 5],
+     "--element-image /nonexistent.img: No such file"),
     (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--holding-margin", "0.5"], "--holding-margin"),
     (["--gearbox", "8hp", "--shift", "shift_1_2_whole_full", "--bench"], "--bench"),
 ]
