@@ -118,3 +118,11 @@ def _detail(image: bytes | None, magic: int, version: int, payload_length: int, 
     if status is ImageStatus.BAD_VERSION:
         return f" ({got_version}, expected {version})"
     return f" ({got_length} bytes, expected {payload_length}; reserved 0x{reserved:08X})"
+
+
+def hex_text(data: bytes, comments: list[str], words_per_line: int = 8) -> str:
+    """An image as a golden vector's text (tests/vectors/*.hex, read by tests/c/wc_test_support.h's
+    wc_test_read_hex): each comment a '# ' line, then the bytes in file order, 4 a group, words_per_line a line."""
+    words = [data[i:i + 4].hex() for i in range(0, len(data), 4)]
+    lines = [" ".join(words[i:i + words_per_line]) for i in range(0, len(words), words_per_line)]
+    return "".join(f"# {c}\n" for c in comments) + "\n".join(lines) + "\n"
