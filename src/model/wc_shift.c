@@ -188,6 +188,24 @@ static float through_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *c
     return wc_shift_clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
 }
 
+/* The slip PI's integral (DESIGN 10), within its anti-windup bound. */
+static void integrate(wc_shift_t *shift, const wc_shift_calibration_t *cal, float error_rad_s, float dt_s)
+{
+    const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error_rad_s * dt_s;
+    const float limit = cal->integral_limit_Nm;
+    shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
+}
+
+/* DESIGN 14, 15: the model's error the slip PI found: its integral beyond the share the feed-forward
+ * leaves to it ((1 - gain) T_t / a: all of it on feedback alone), never below 0. The lock-up ramps to the
+ * holding margin plus this: the margin does not cover a model error (a cold pack whose friction the model
+ * overrates held the 8-speed's 6->7 at 20 degC short of lock-up: AbortReason 2). */
+static float model_error_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float share_Nm)
+{
+    const float excess_Nm = shift->integral_Nm - (1.0f - cal->feedforward_gain) * share_Nm;
+    return (excess_Nm > 0.0f) ? excess_Nm : 0.0f;
+}
+
 /* The flare (DESIGN 14): the off-going clutch slipping forward, the turbine above the 1st-gear speed. */
 static float flare_slip_rad_s(const wc_shift_t *shift)
 {
@@ -255,11 +273,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         shift->inertia_periods++;
         /* anti-windup: no integration further into a saturated request */
         const bool blocked = (saturated && (error > 0.0f)) || ((shift->request_Nm <= 0.0f) && (error < 0.0f));
-        if (!blocked) {
-            const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error * dt_s;
-            const float limit = cal->integral_limit_Nm;
-            shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
-        }
+        if (!blocked) { integrate(shift, cal, error, dt_s); }
         if (slip_rad_s > shift->start_slip_rad_s + cal->flare_slip_rad_s) { shift->report.flare = true; }
         if ((slip_rad_s >= shift->start_slip_rad_s) && (shift->request_Nm > cal->tie_up_factor * share_Nm)) {
             shift->report.tie_up = true;  /* the turbine does not move although the clutch pulls hard: something holds it */
@@ -271,7 +285,12 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
                                     ? (shift->driver_torque_Nm / cal->turbine_ratio) : share_Nm;
     if (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) {
         const uint32_t n = wc_shift_periods_of(cal->lockup_ramp_time_s, dt_s);
-        const float hold_Nm = cal->holding_torque_factor * hold_share_Nm;
+        /* DESIGN 15: on the whole shift the lock-up is not open loop: the PI goes on, and the ramp carries
+         * the model's error it found (the anti-windup as in the inertia phase) */
+        if (coord && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) && !(saturated && (slip_rad_s > 0.0f))) {
+            integrate(shift, cal, slip_rad_s, dt_s);  /* the slip left: the error on a zero reference */
+        }
+        const float hold_Nm = cal->holding_torque_factor * hold_share_Nm + (coord ? model_error_Nm(shift, cal, share_Nm) : 0.0f);
         const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;
         return shift->phase_start_request_Nm + (hold_Nm - shift->phase_start_request_Nm) * ((x < 1.0f) ? x : 1.0f);
     }
@@ -381,7 +400,7 @@ void wc_shift_transitions(wc_shift_t *shift, const wc_shift_calibration_t *cal, 
  * state, then the clutch input (in place: mode, request, carried torque, lag
  * compensation, temperature source). saturated: the last step's output was. */
 static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibration_t *cal, const wc_shift_command_t *command,
-                         bool safe, bool saturated, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
+                         bool safe, bool saturated, float viscous_Nm, float slip_rad_s, float dt_s, const wc_clutch_t *clutch,
                          wc_adapt_t *adapt, wc_step_input_t *in, const wc_shift_offgoing_t *offgoing)
 {
     const bool coord = coordinated(cal, offgoing);
@@ -407,8 +426,13 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
         /* once synchronous the clutch carries what the driveline model says
          * (the feed-forward at a zero slip rate), not the request */
         const float carried_Nm = feedforward_Nm(&d, 0.0f);
+        /* DESIGN 15: the lock-up closes the slip to hold by static friction, and the modelled viscous drag at
+         * the slip left vanishes as it closes: the inverse (at the measured slip) is asked for it on top, or a
+         * cold pack whose drag the model overrates stays at its kiss point (8-speed 6->7 at 20 degC: the
+         * model's drag at the kiss point met the ramp's request, the slip never closed: AbortReason 2) */
+        const float drag_Nm = (coord && (shift->phase == (uint32_t)WC_SHIFT_LOCKUP)) ? fabsf(viscous_Nm) : 0.0f;
         const float request_Nm = wc_shift_clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm,
-                                                                  coord));
+                                                                  coord) + drag_Nm);
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {
             in->mode = WC_MODE_TORQUE;
             in->torque_request_Nm = request_Nm;
@@ -675,7 +699,7 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
             shift->fallback_periods = 0u;
         }
     }
-    shift_before(shift, cal, command, safe, saturated, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
+    shift_before(shift, cal, command, safe, saturated, out->model.viscous_Nm, slip_rad_s, dt_s, clutch, adapt, in, offgoing);
     (void)wc_clutch_step(clutch, in, out);
     if (coord) {  /* DESIGN 14: the fill pulse, the off-going clutch (one clutch step deep), the engine */
         wc_shift_fill_pulse(cal, clutch, shift->phase == (uint32_t)WC_SHIFT_PREPARE, shift->phase_periods, dt_s, out);
