@@ -183,9 +183,10 @@ class Transmission:
         """False: refused (in a shift, or outside the shift calibration's bands)."""
         return self.lib.wc_host_tx_load_learned(self.state, element, ctypes.byref(values)) == 0
 
-    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> _Step:
+    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing, safe=False) -> _Step:
+        """safe: the loop's safe state (a lost input; NaN speeds are one too)."""
         self.lib.wc_host_tx_step(self.state, int(request), current, target, torque_Nm, target_s, w_t, w_o, oil,
-                                 housing, 0, ctypes.byref(self.out))
+                                 housing, int(bool(safe)), ctypes.byref(self.out))
         return self.out
 
 
@@ -247,13 +248,18 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
 
 
 def trace_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, oil_degC: float = OIL_DEGC,
-                seed: int = 1, lib=None) -> ShiftTrace:
-    """run_shift's run with its per-period traces (ShiftTrace: its .quality is run_shift's dict)."""
-    return _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu=True)
+                seed: int = 1, lib=None, fault=None) -> ShiftTrace:
+    """run_shift's run with its per-period traces (ShiftTrace: its .quality is run_shift's dict). fault: (phase
+    of PHASES, offset_s, duration_s): both speeds lost (NaN, the loop's safe state) from offset_s after the TCU
+    first reports the phase, for duration_s (faults8)."""
+    return _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu=True, fault=fault)
 
 
-def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu: bool) -> ShiftTrace:
-    """The closed loop of run_shift; keep_tcu: the TCU's outputs kept per period (else ShiftTrace.tcu is empty)."""
+def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu: bool, fault=None) -> ShiftTrace:
+    """The closed loop of run_shift; keep_tcu: the TCU's outputs kept per period (else ShiftTrace.tcu is empty);
+    fault: trace_shift's."""
+    if fault is not None and fault[0] not in PHASES:
+        raise ShiftError(f"fault: phase {fault[0]!r} is not one of {PHASES}")
     params, _models = _plant_and_models(str(plant_path(vehicle)))
     direction, pedal, rpm = SCENARIOS[kind]
     if target - source != direction * abs(target - source):
@@ -273,13 +279,20 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
     theta_estimate = []          # the on-coming element's observer per period
     tcu_rows = []                # keep_tcu: the TCU's outputs per period (_tcu_row)
     on_index = _oncoming_index(params, src, tgt)
+    lost_from, lost_periods = None, (int(round(fault[2] / dt)) if fault is not None else 0)
     for k in range(n_max):
         z = rng.standard_normal(4)
         q = v.slip_resolution
         w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q) * q * RPM
         w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q) * q * RPM
         torque = st["engine_torque_Nm"] * (1.0 + v.torque_estimate_bias) + v.torque_estimate_noise * z[2]
-        o = tx.step(k >= n_pre, source, target, torque, TARGET_S[kind], w_t, w_o, plant.oil_degC, plant.housing_degC)
+        lost = lost_from is not None and lost_from <= k < lost_from + lost_periods
+        if lost:
+            w_t = w_o = math.nan
+        o = tx.step(k >= n_pre, source, target, torque, TARGET_S[kind], w_t, w_o, plant.oil_degC, plant.housing_degC,
+                    safe=lost)
+        if fault is not None and lost_from is None and k >= n_pre and PHASES[o.phase] == fault[0]:
+            lost_from = k + 1 + int(round(fault[1] / dt))
         if k == n_pre:
             if o.refusal != 0:
                 raise ShiftError(f"{src}->{tgt}: refused (wc_gearbox_shift_result_t {o.refusal})")
@@ -345,6 +358,7 @@ def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, 
     # the 1->2 runs' and the power-on matrix's measure (quality.py): the acceleration low-passed, then its rate
     jerk = np.gradient(_lowpass_zero_phase(truth["vehicle_accel_m_s2"], dt, JERK_CUTOFF_HZ), dt)
     abort = int(report[7]) if report else -1
+    fallback = int(report[8]) if report and math.isfinite(report[8]) else -1   # NaN through frames: not on the bus
     inertia = float(report[0]) if report else math.nan
     energy = {e: float(truth[f"{e}_energy_J"][-1] - truth[f"{e}_energy_J"][n_pre]) * 1e-3 for e in ELEMENTS}
     theta_est = max(theta_estimate[n_pre:]) if len(theta_estimate) > n_pre else math.nan
@@ -354,7 +368,7 @@ def _quality(plant, truth, theta_estimate, report, end_k, n_pre, gears, ratios, 
     w_t_all, w_o_all = truth["turbine_speed_rpm"][n_pre + 1:], truth["output_speed_rpm"][n_pre + 1:]
     at_new = np.nonzero(np.abs(w_t_all - ratio_tgt * w_o_all) <= END_RATIO_TOLERANCE * ratio_tgt * w_o_all)[0]
     new_speed_s = float(at_new[0] + 1) * dt if at_new.size else math.nan
-    return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort,
+    return {**case, "shift": f"{src}->{tgt}", "type": kind_seen, "abort": abort, "fallback": fallback,
             "end_gear": _end_gear(plant, st_end), "duration_s": (end_k - n_pre) * dt if end_k else math.nan,
             "inertia_time_s": inertia, "target_s": TARGET_S[case["kind"]], "new_speed_s": new_speed_s,
             "peak_jerk_m_s3": float(np.max(np.abs(jerk[sl]), initial=0.0)),

@@ -52,9 +52,10 @@ class FrameTransmission:
         self._data = ctypes.create_string_buffer(8 * MAX_FRAMES)
         self.k = 0
 
-    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing) -> _Step:
+    def step(self, request, current, target, torque_Nm, target_s, w_t, w_o, oil, housing, safe=False) -> _Step:
+        """Transmission.step's; safe is the frame loop's own (its inputs' freshness): the argument is ignored."""
         rc = self.lib.wc_host_tx_step(self.state, int(request), current, target, torque_Nm, target_s, w_t, w_o, oil,
-                                      housing, 0, ctypes.byref(self.out))
+                                      housing, int(bool(safe)), ctypes.byref(self.out))
         if rc != 0:
             raise ShiftError(f"the frame loop's step {self.k}: its frames did not decode (code {rc})")
         if self.record:
