@@ -65,6 +65,21 @@ static float oncoming_carried_Nm(const wc_shift_calibration_t *cal, float turbin
 #define WC_SHIFT_KICKDOWN_JERK_m_s3 12.0f
 #define WC_SHIFT_TIPOUT_JERK_m_s3 3.0f
 
+/* DESIGN 15: a coast downshift requested with the pedal pressed (T_t0 > 0, below the power-on type's 50 N m:
+ * a downshift on the down line at part pedal) takes the drive away at this rate of the turbine
+ * torque, over the engine's lag at least: the off-going element's ramp out and the engine's reduction to its
+ * zero torque, so the output's fall stays within the coast's 5 m/s^3 (the 8HP's 2->1 on the open converter at
+ * T_t 12 / 31 / 46 N m: 3.2 / 3.6 / 5.6 m/s^3; at 100 N m/s 4.7 / 4.2 / 5.6; over the engine's lag alone, 90 ms,
+ * 31 N m jerked 11.4). A design constant as the two above. */
+#define WC_SHIFT_PRESSED_RATE_Nm_per_s 60.0f
+
+/* The time the pressed drive's ramp out takes (above); the engine's lag without a pressed pedal. */
+static float drive_ramp_s(const wc_shift_t *shift, const wc_shift_calibration_t *cal)
+{
+    const float ramp_s = shift->driver_torque_Nm / WC_SHIFT_PRESSED_RATE_Nm_per_s;  /* <= 0 without a pressed pedal */
+    return (ramp_s > cal->engine_lead_time_s) ? ramp_s : cal->engine_lead_time_s;
+}
+
 /* The slip jerk j (rad/s^3, the rate of d(slip)/dt) that gives the vehicle
  * the jerk J (DESIGN 10, 15, with the relations above): while the off-going
  * clutch holds back, d(slip)/dt = T_t / I_t - k_1 T_1 and the output torque
@@ -314,14 +329,21 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
             (void)reference_at(shift, &profile, elapsed_s + cal->engine_lead_time_s, &lead_rate_rad_s2);
             const float correction_Nm = -pi_Nm * k_1 * cal->turbine_inertia_kg_m2;
             const float want_Nm = cal->turbine_inertia_kg_m2 * lead_rate_rad_s2 - shift->driver_torque_Nm + correction_Nm;
-            r.engine_Nm = (want_Nm > 0.0f) ? ((want_Nm < cal->engine_increase_max_Nm) ? want_Nm : cal->engine_increase_max_Nm)
-                                           : 0.0f;
+            /* DESIGN 15: with the driver's pedal pressed (T_t0 > 0: a downshift on the down line below the
+             * power-on type's torque) the turbine runs ahead of the reference on its own: the engine takes back
+             * down to its zero torque (-T_t0), as the power-on upshift's reduction (the 8HP's 2->1 on the open
+             * converter at T_t 31 N m synchronised at 0.57 s of 2.0 and flared 93 rpm) */
+            const float ramp_s = drive_ramp_s(shift, cal);
+            const float ramp_x = (elapsed_s < ramp_s) ? (elapsed_s / ramp_s) : 1.0f;
+            const float floor_Nm = (shift->driver_torque_Nm > 0.0f) ? -shift->driver_torque_Nm * ramp_x : 0.0f;
+            r.engine_Nm = (want_Nm > floor_Nm) ? ((want_Nm < cal->engine_increase_max_Nm) ? want_Nm : cal->engine_increase_max_Nm)
+                                               : floor_Nm;
             shift->engine_from_Nm = r.engine_Nm;  /* where the torque phase's ramp-out starts */
         }
         /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist (with the
          * engine: not while the engine is at either limit, its clutches are open) */
         const bool engine_full = engine && !(r.engine_Nm < cal->engine_increase_max_Nm);
-        const bool engine_none = engine && !(r.engine_Nm > 0.0f);
+        const bool engine_none = engine && !(r.engine_Nm > ((shift->driver_torque_Nm > 0.0f) ? -shift->driver_torque_Nm : 0.0f));
         const bool blocked = (offgoing_saturated && (error > 0.0f) && !engine) || ((error > 0.0f) && engine_none) ||
                              ((error < 0.0f) && (assist ? oncoming_saturated : (engine ? engine_full : (holdback_Nm <= 0.0f))));
         if (!blocked) {
@@ -336,8 +358,12 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
              * rises through 0 (T_t, the engine's estimate, has the intervention in it), with the margin, then
              * opens for good: no step of the output torque, no hold-back against the engine. At the latest
              * after the engine's lag (engine_lead_time_s: an estimate without the intervention would hold it) */
-            const float lag_left = (cal->engine_lead_time_s > 0.0f) ? (1.0f - elapsed_s / cal->engine_lead_time_s) : 0.0f;
-            const float drag_now_Nm = (t_t_Nm < 0.0f) ? offgoing_carried_Nm(cal, t_t_Nm) : 0.0f;
+            const float lag_s = drive_ramp_s(shift, cal);
+            const float lag_left = (lag_s > 0.0f) ? (1.0f - elapsed_s / lag_s) : 0.0f;
+            /* (with the pedal pressed at the request, T_t0 > 0, it carries the drive the engine's reduction
+             * takes away: the same ramp out, not a step of the output torque) */
+            const bool pressed = shift->driver_torque_Nm > 0.0f;
+            const float drag_now_Nm = ((t_t_Nm < 0.0f) || pressed) ? offgoing_carried_Nm(cal, t_t_Nm) : 0.0f;
             const float drag_lag_Nm = (lag_left > 0.0f) ? (lag_left * offgoing_carried_Nm(cal, shift->driver_torque_Nm)) : 0.0f;
             const float drag_Nm = (drag_now_Nm < drag_lag_Nm) ? drag_now_Nm : drag_lag_Nm;
             r.offgoing_Nm = (1.0f + cal->offgoing_margin_factor) * drag_Nm;
@@ -498,7 +524,7 @@ bool wc_shift_inertia_first_step(wc_shift_t *shift, const wc_shift_calibration_t
     wc_shift_fill_pulse(cal, clutch, filling, oncoming_assist ? shift->phase_periods : (fill_periods - 1u), dt_s, out);
     (void)wc_clutch_step(offgoing->clutch, offgoing->in, offgoing->out);
     /* the engine request (the coast downshift); none in the safe state or a fallback */
-    offgoing->engine_active = engine && (r.engine_Nm > 0.0f) && !safe &&
+    offgoing->engine_active = engine && ((r.engine_Nm > 0.0f) || (r.engine_Nm < 0.0f)) && !safe &&
                               (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE);
     offgoing->engine_delta_Nm = offgoing->engine_active ? r.engine_Nm : 0.0f;
 

@@ -344,6 +344,21 @@ def test_cold_kickdown_hands_over_without_the_offgoing_drag():
     assert r["excursion_rpm"] <= 30.0, r
 
 
+def test_coast_downshift_with_the_pedal_pressed_takes_the_drive_away_smoothly():
+    """A coast downshift requested with the pedal pressed (the WLTC's 2->1 on the down line, the converter open,
+    T_t 31 N m, below the power-on type's 50): the off-going element was released at once and the engine could
+    only add torque, so the turbine ran ahead of the reference on its own (synchronised at 0.57 s of 2.0, flare
+    93 rpm, 13.2 m/s^3; in the cycle such shifts failed to lock). The engine now takes the drive back to its
+    zero torque and the off-going element ramps out with it, at WC_SHIFT_PRESSED_RATE_Nm_per_s."""
+    r = t8.trace_shift("nominal", 2, 1, "power-off downshift", oil_degC=80.0, pedal=0.2, lockup_current_mA=0.0,
+                       rpm=1300.0).quality
+    assert r["type"] == "power-off downshift" and r["turbine_torque_Nm"] > 25.0, r   # the pedal pressed
+    assert r["abort"] == 0 and r["end_gear"] == "1", r
+    assert abs(r["inertia_time_s"] / r["target_s"] - 1.0) <= t8.INERTIA_TOLERANCE, r  # 1.99 of 2.0 (0.57 before)
+    assert r["excursion_rpm"] <= t8.EXCURSION_RPM, r                                   # 0 (93 before)
+    assert r["peak_jerk_m_s3"] <= t8.LIMITS_JERK["power-off downshift"], r             # 3.6 (13.2 before)
+
+
 def test_cold_tipout_closes_the_slip_its_drag_holds_open():
     """A tip-out's hand-over at 20 degC (6->7: A on-coming at 6.2 x the controller's slip): at its kiss point A's
     viscous drag carried the engine's drag (T_t -21 N m) at 4 rad/s of its own slip, which never closed, and
