@@ -431,16 +431,19 @@ bool wc_shift_step(wc_shift_t *shift, const wc_shift_calibration_t *cal, const w
  *             reported locked without the slip), released after
  *             fallback_time_s.
  * With WC_SHIFT_INERTIA_FIRST_ENGINE (the coast downshift, not mirrored: T_t
- * <= 0, the engine drags and cannot raise the turbine) the engine does the
+ * below the power-on type's, the engine cannot raise the turbine) the engine does the
  * inertia phase (DESIGN 15: "engine torque increase requested"): the request
  * I_t dref/dt - T_t0 at the reference engine_lead_time_s ahead, corrected by
  * the PI both ways (-PI k_1 I_t: more when the turbine lags, less when it
  * runs ahead) with its gains scaled to the engine's lag (kp to a crossover at
  * 1 / (2 engine_lead_time_s), ki by the square of that factor), within 0 ..
- * engine_increase_max_Nm; at synchronism cut to what cancels the drag and
- * ramped out over the torque phase. The off-going clutch carries what is left
- * of the drag (with the margin) while the engine's torque rises through 0,
- * at the latest for engine_lead_time_s, then opens for good; the target is
+ * engine_increase_max_Nm (with T_t0 > 0, a pressed pedal or a converter's
+ * creep, from -min(T_t0, engine_reduction_max_Nm), ramped in at 60 N m/s);
+ * at synchronism cut to what cancels the drag and ramped out over the torque
+ * phase. The off-going clutch carries what is left of the drag (with T_t0 > 0
+ * the drive, |T_t|) with the margin while the engine's torque goes through 0,
+ * at the latest for engine_lead_time_s (with T_t0 > 0 the ramp's time), then
+ * opens for good; the target is
  * stretched to what T_t0 + engine_increase_max_Nm can do. The on-coming
  * clutch then never drags the vehicle into the turbine's acceleration.
  * Without it no engine request (engine_active false). No adaptation in this

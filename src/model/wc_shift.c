@@ -427,10 +427,12 @@ static WC_NOINLINE void shift_before(wc_shift_t *shift, const wc_shift_calibrati
          * (the feed-forward at a zero slip rate), not the request */
         const float carried_Nm = feedforward_Nm(&d, 0.0f);
         /* DESIGN 15: the lock-up closes the slip to hold by static friction, and the modelled viscous drag at
-         * the slip left vanishes as it closes: the inverse (at the measured slip) is asked for it on top, or a
-         * cold pack whose drag the model overrates stays at its kiss point (8-speed 6->7 at 20 degC: the
-         * model's drag at the kiss point met the ramp's request, the slip never closed: AbortReason 2) */
-        const float drag_Nm = (coord && (shift->phase == (uint32_t)WC_SHIFT_LOCKUP)) ? fabsf(viscous_Nm) : 0.0f;
+         * the slip left vanishes as it closes: the inverse (at the measured slip) is asked for it on top (the
+         * last step's model), or a cold pack whose drag the model overrates stays at its kiss point (8-speed
+         * 6->7 at 20 degC: the model's drag at the kiss point met the ramp's request, the slip never closed:
+         * AbortReason 2). A drag beyond the torque range (NaN included) adds nothing. */
+        const bool drag_valid = fabsf(viscous_Nm) <= WC_TORQUE_MAX_Nm;
+        const float drag_Nm = (coord && (shift->phase == (uint32_t)WC_SHIFT_LOCKUP) && drag_valid) ? fabsf(viscous_Nm) : 0.0f;
         const float request_Nm = wc_shift_clamp_torque_Nm(phase_request_Nm(shift, cal, slip_rad_s, dt_s, saturated, &d, carried_Nm,
                                                                   coord) + drag_Nm);
         if (shift->phase != (uint32_t)WC_SHIFT_ABORTED) {

@@ -80,6 +80,20 @@ static float drive_ramp_s(const wc_shift_t *shift, const wc_shift_calibration_t 
     return (ramp_s > cal->engine_lead_time_s) ? ramp_s : cal->engine_lead_time_s;
 }
 
+/* The coast downshift's lowest engine request elapsed_s into its inertia phase: 0, or with T_t0 > 0 down to
+ * the engine's zero torque (-T_t0, at most engine_reduction_max_Nm as the power-on upshift's reduction),
+ * ramped in over drive_ramp_s. T_t0 > 0 is the engine's drive at the request: a pressed pedal, or an open
+ * converter's creep at idle, where the engine has little to give back. */
+static float engine_floor_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *cal, float elapsed_s)
+{
+    if (!(shift->driver_torque_Nm > 0.0f)) { return 0.0f; }
+    const float ramp_s = drive_ramp_s(shift, cal);
+    const float x = (elapsed_s < ramp_s) ? (elapsed_s / ramp_s) : 1.0f;  /* ramp_s >= T_t0 / rate > 0 */
+    const float drive_Nm = (shift->driver_torque_Nm < cal->engine_reduction_max_Nm) ? shift->driver_torque_Nm
+                                                                                    : cal->engine_reduction_max_Nm;
+    return -drive_Nm * x;
+}
+
 /* The slip jerk j (rad/s^3, the rate of d(slip)/dt) that gives the vehicle
  * the jerk J (DESIGN 10, 15, with the relations above): while the off-going
  * clutch holds back, d(slip)/dt = T_t / I_t - k_1 T_1 and the output torque
@@ -333,9 +347,7 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
              * power-on type's torque) the turbine runs ahead of the reference on its own: the engine takes back
              * down to its zero torque (-T_t0), as the power-on upshift's reduction (the 8HP's 2->1 on the open
              * converter at T_t 31 N m synchronised at 0.57 s of 2.0 and flared 93 rpm) */
-            const float ramp_s = drive_ramp_s(shift, cal);
-            const float ramp_x = (elapsed_s < ramp_s) ? (elapsed_s / ramp_s) : 1.0f;
-            const float floor_Nm = (shift->driver_torque_Nm > 0.0f) ? -shift->driver_torque_Nm * ramp_x : 0.0f;
+            const float floor_Nm = engine_floor_Nm(shift, cal, elapsed_s);
             r.engine_Nm = (want_Nm > floor_Nm) ? ((want_Nm < cal->engine_increase_max_Nm) ? want_Nm : cal->engine_increase_max_Nm)
                                                : floor_Nm;
             shift->engine_from_Nm = r.engine_Nm;  /* where the torque phase's ramp-out starts */
@@ -343,7 +355,7 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist (with the
          * engine: not while the engine is at either limit, its clutches are open) */
         const bool engine_full = engine && !(r.engine_Nm < cal->engine_increase_max_Nm);
-        const bool engine_none = engine && !(r.engine_Nm > ((shift->driver_torque_Nm > 0.0f) ? -shift->driver_torque_Nm : 0.0f));
+        const bool engine_none = engine && !(r.engine_Nm > engine_floor_Nm(shift, cal, elapsed_s));
         const bool blocked = (offgoing_saturated && (error > 0.0f) && !engine) || ((error > 0.0f) && engine_none) ||
                              ((error < 0.0f) && (assist ? oncoming_saturated : (engine ? engine_full : (holdback_Nm <= 0.0f))));
         if (!blocked) {
@@ -357,7 +369,8 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
             /* the coast downshift's off-going clutch carries what is left of the drag while the engine's torque
              * rises through 0 (T_t, the engine's estimate, has the intervention in it), with the margin, then
              * opens for good: no step of the output torque, no hold-back against the engine. At the latest
-             * after the engine's lag (engine_lead_time_s: an estimate without the intervention would hold it) */
+             * after the engine's lag (engine_lead_time_s: an estimate without the intervention would hold it),
+             * or with T_t0 > 0 after drive_ramp_s */
             const float lag_s = drive_ramp_s(shift, cal);
             const float lag_left = (lag_s > 0.0f) ? (1.0f - elapsed_s / lag_s) : 0.0f;
             /* (with the pedal pressed at the request, T_t0 > 0, it carries the drive the engine's reduction
