@@ -188,14 +188,6 @@ static float through_Nm(const wc_shift_t *shift, const wc_shift_calibration_t *c
     return wc_shift_clamp_torque_Nm(shift->turbine_torque_Nm - cal->turbine_inertia_kg_m2 * shift->slip_rate_rad_s2 / gear_step);
 }
 
-/* The slip PI's integral (DESIGN 10), within its anti-windup bound. */
-static void integrate(wc_shift_t *shift, const wc_shift_calibration_t *cal, float error_rad_s, float dt_s)
-{
-    const float integral = shift->integral_Nm + cal->ki_Nm_per_rad * error_rad_s * dt_s;
-    const float limit = cal->integral_limit_Nm;
-    shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
-}
-
 /* DESIGN 14, 15: the model's error the slip PI found: its integral beyond the share the feed-forward
  * leaves to it ((1 - gain) T_t / a: all of it on feedback alone), never below 0. The lock-up ramps to the
  * holding margin plus this: the margin does not cover a model error (a cold pack whose friction the model
@@ -273,7 +265,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         shift->inertia_periods++;
         /* anti-windup: no integration further into a saturated request */
         const bool blocked = (saturated && (error > 0.0f)) || ((shift->request_Nm <= 0.0f) && (error < 0.0f));
-        if (!blocked) { integrate(shift, cal, error, dt_s); }
+        if (!blocked) { wc_shift_integrate(shift, cal, cal->ki_Nm_per_rad * error * dt_s); }
         if (slip_rad_s > shift->start_slip_rad_s + cal->flare_slip_rad_s) { shift->report.flare = true; }
         if ((slip_rad_s >= shift->start_slip_rad_s) && (shift->request_Nm > cal->tie_up_factor * share_Nm)) {
             shift->report.tie_up = true;  /* the turbine does not move although the clutch pulls hard: something holds it */
@@ -288,7 +280,7 @@ static float phase_request_Nm(wc_shift_t *shift, const wc_shift_calibration_t *c
         /* DESIGN 15: on the whole shift the lock-up is not open loop: the PI goes on, and the ramp carries
          * the model's error it found (the anti-windup as in the inertia phase) */
         if (coord && (shift->fallback == (uint32_t)WC_SHIFT_FALLBACK_NONE) && !(saturated && (slip_rad_s > 0.0f))) {
-            integrate(shift, cal, slip_rad_s, dt_s);  /* the slip left: the error on a zero reference */
+            wc_shift_integrate(shift, cal, cal->ki_Nm_per_rad * slip_rad_s * dt_s);  /* the slip left: the error on a zero reference */
         }
         const float hold_Nm = cal->holding_torque_factor * hold_share_Nm + (coord ? model_error_Nm(shift, cal, share_Nm) : 0.0f);
         const float x = (n > 0u) ? ((float)(shift->phase_periods + 1u) / (float)n) : 1.0f;

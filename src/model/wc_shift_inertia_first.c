@@ -333,6 +333,8 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         const float engine_gain = engine ? engine_loop_gain(cal, k_1) : 1.0f;
         const float pi_Nm = engine_gain * cal->kp_Nm_per_rad_s * error + shift->integral_Nm;
         const float holdback_Nm = ff_Nm + pi_Nm;
+        /* the coast downshift's lowest engine request (engine_floor_Nm: 0 but with T_t0 > 0) */
+        const float floor_Nm = engine ? engine_floor_Nm(shift, cal, elapsed_s) : 0.0f;
         if (engine) {
             /* the coast downshift: the engine accelerates the turbine on the reference, engine_lead_time_s ahead
              * (its lag): I_t dref/dt - T_t0; the PI's correction -PI k_1 I_t (the turbine torque that a hold-back
@@ -347,7 +349,6 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
              * power-on type's torque) the turbine runs ahead of the reference on its own: the engine takes back
              * down to its zero torque (-T_t0), as the power-on upshift's reduction (the 8HP's 2->1 on the open
              * converter at T_t 31 N m synchronised at 0.57 s of 2.0 and flared 93 rpm) */
-            const float floor_Nm = engine_floor_Nm(shift, cal, elapsed_s);
             r.engine_Nm = (want_Nm > floor_Nm) ? ((want_Nm < cal->engine_increase_max_Nm) ? want_Nm : cal->engine_increase_max_Nm)
                                                : floor_Nm;
             shift->engine_from_Nm = r.engine_Nm;  /* where the torque phase's ramp-out starts */
@@ -355,14 +356,10 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
         /* anti-windup: no integration further into a saturated clutch, nor below 0 without the assist (with the
          * engine: not while the engine is at either limit, its clutches are open) */
         const bool engine_full = engine && !(r.engine_Nm < cal->engine_increase_max_Nm);
-        const bool engine_none = engine && !(r.engine_Nm > engine_floor_Nm(shift, cal, elapsed_s));
+        const bool engine_none = engine && !(r.engine_Nm > floor_Nm);
         const bool blocked = (offgoing_saturated && (error > 0.0f) && !engine) || ((error > 0.0f) && engine_none) ||
                              ((error < 0.0f) && (assist ? oncoming_saturated : (engine ? engine_full : (holdback_Nm <= 0.0f))));
-        if (!blocked) {
-            const float integral = shift->integral_Nm + engine_gain * engine_gain * cal->ki_Nm_per_rad * error * dt_s;
-            const float limit = cal->integral_limit_Nm;
-            shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
-        }
+        if (!blocked) { wc_shift_integrate(shift, cal, engine_gain * engine_gain * cal->ki_Nm_per_rad * error * dt_s); }
         if (slip_rad_s > cal->flare_slip_rad_s) { shift->report.flare = true; }  /* past synchronism */
         r.offgoing_Nm = holdback_Nm;
         if (engine) {

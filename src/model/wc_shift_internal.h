@@ -33,6 +33,15 @@ static inline float wc_shift_clamp_torque_Nm(float torque_Nm)
     return (torque_Nm > 0.0f) ? ((torque_Nm < WC_TORQUE_MAX_Nm) ? torque_Nm : WC_TORQUE_MAX_Nm) : 0.0f;
 }
 
+/* The slip PI's integral (DESIGN 10) advanced by increment_Nm (ki x error x dt, times the controller's loop
+ * gain squared), within the calibration's anti-windup bound: the one home of both controllers' integral. */
+static inline void wc_shift_integrate(wc_shift_t *shift, const wc_shift_calibration_t *cal, float increment_Nm)
+{
+    const float integral = shift->integral_Nm + increment_Nm;
+    const float limit = cal->integral_limit_Nm;
+    shift->integral_Nm = (integral > limit) ? limit : ((integral < -limit) ? -limit : integral);
+}
+
 static inline uint32_t wc_shift_periods_of(float time_s, float dt_s)
 {
     const float n = time_s / dt_s + 0.5f;  /* both checked: time <= 10 s, dt >= 1e-4 s */

@@ -21,13 +21,13 @@ left, and the fault adds no flare: the turbine's excursion beyond the two gears'
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
+from ..calibration import shift as shift_calibration
 from . import transmission8 as t8
 
 # wc_shift_fallback_t (include/wetclutch/wc_shift.h), by value
@@ -58,6 +58,13 @@ def family(kind: str) -> str:
     return "torque-first" if kind in TORQUE_FIRST else "inertia-first"
 
 
+@functools.lru_cache(maxsize=1)
+def fallback_time_s() -> float:
+    """The controller's shift calibration's fallback_time_s: a finish on the model longer than this releases."""
+    base = shift_calibration.load(t8.SHIFT_TOML).variants[t8.CONTROLLER]
+    return float(base.values["fallback_time"])
+
+
 def expected(kind: str, fault: str, source: int, target: int) -> tuple[int, str]:
     """(the fallback, the gear held at the end) the shift layer and the transmission document for fault in
     kind (module docstring)."""
@@ -66,18 +73,15 @@ def expected(kind: str, fault: str, source: int, target: int) -> tuple[int, str]
     before_gear = phase == "prepare" or (phase == "torque" if first else phase == "inertia")
     if before_gear:
         return HANDBACK, str(source)
-    return (RELEASED if duration_s >= 1.0 else FINISH), str(target)
+    return (RELEASED if duration_s > fallback_time_s() else FINISH), str(target)
 
 
-def _phases_while_lost(trace: t8.ShiftTrace, fault) -> list[str] | None:
-    """The TCU's phases while the input was lost, each once in their order (None: the phase never came)."""
-    phases = np.asarray(trace.tcu["phase"], dtype=int)
-    names = [t8.PHASES[p] for p in phases]
-    start = next((k for k in range(trace.request_index, len(names)) if names[k] == fault[0]), None)
-    if start is None:
+def _phases_while_lost(trace: t8.ShiftTrace) -> list[str] | None:
+    """The TCU's phases in the periods whose input was lost (ShiftTrace.lost), each once in their order (None:
+    the fault's phase never came)."""
+    if trace.lost is None:
         return None
-    k0 = start + 1 + int(round(fault[1] / 1e-3))
-    window = names[k0:k0 + int(round(fault[2] / 1e-3))]
+    window = [t8.PHASES[int(p)] for p in trace.tcu["phase"][trace.lost[0]:trace.lost[1]]]
     return [p for i, p in enumerate(window) if i == 0 or p != window[i - 1]]
 
 
@@ -89,7 +93,7 @@ def run_row(vehicle: str, source: int, target: int, kind: str, load: float, faul
     trace = t8.trace_shift(vehicle, source, target, kind, load=load, oil_degC=oil_degC, lib=lib, fault=spec)
     q = trace.quality
     fallback, gear = expected(kind, fault, source, target)
-    seen = _phases_while_lost(trace, spec)
+    seen = _phases_while_lost(trace)
     row = {"vehicle": vehicle, "shift": q["shift"], "type": q["type"], "fault": fault, "phase": spec[0],
            "offset_s": spec[1], "duration_s": spec[2], "fallback": FALLBACKS[q["fallback"]] if q["fallback"] >= 0
            else "no report", "abort": q["abort"], "end_gear": q["end_gear"], "excursion_rpm": q["excursion_rpm"],

@@ -220,7 +220,9 @@ class ShiftTrace:
     (TCU_CHANNELS; empty from run_shift): what the TCU put out in period k = 0 .. n - 1, computed from the
     measurement of truth row k and applied over period k (the plant records that period's currents in row k + 1);
     request_index the period of the request's edge, end_index the one the shift ended in (None: it did not);
-    ratios the source and the target gear's (their synchronous turbine speeds: ratio x the output speed)."""
+    ratios the source and the target gear's (their synchronous turbine speeds: ratio x the output speed);
+    lost the periods [first, end) whose input trace_shift's fault took away (None: no fault, or its phase never
+    came)."""
     quality: dict
     truth: dict
     tcu: dict
@@ -229,6 +231,7 @@ class ShiftTrace:
     ratios: tuple[float, float]
     oncoming: str
     offgoing: str
+    lost: tuple[int, int] | None = None
 
     def time_s(self) -> np.ndarray:
         """The truth rows' times from the request (the TCU's row k is at row k's)."""
@@ -320,7 +323,8 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
                        (ratio_src, ratio_tgt), kind_seen, {"vehicle": str(vehicle), "kind": kind, "load": load,
                                                            "oil_degC": oil_degC, "pedal": pedal})
     tcu = dict(zip(TCU_CHANNELS, np.array(tcu_rows, dtype=float).T)) if tcu_rows else {}
-    return ShiftTrace(quality, truth, tcu, n_pre, end_k, (ratio_src, ratio_tgt), on, off)
+    lost = (lost_from, lost_from + lost_periods) if lost_from is not None else None
+    return ShiftTrace(quality, truth, tcu, n_pre, end_k, (ratio_src, ratio_tgt), on, off, lost)
 
 
 def _oncoming_index(params, src: str, tgt: str) -> int:
