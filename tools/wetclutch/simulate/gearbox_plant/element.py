@@ -32,12 +32,16 @@ the bench's _Physics), with the element's own calibration.
 """
 from __future__ import annotations
 
+import bisect
 import math
+
+import numpy as np
 
 from ...reference import model
 from ..bench.physics import _Physics
 
 FILM_AT_REST = 1e-7        # relative force mismatch under which a film under a held force counts as converged
+_np_exp = np.exp           # bound once: the viscosity is evaluated per element every period
 
 
 class TrueElement:
@@ -67,6 +71,29 @@ class TrueElement:
         self.open_gap = stroke_m / cal.friction_pairs if self.fill_on else 0.0
         self.inv_wa2 = 1.0 / aeration_speed ** 2
         self._film_table = model.FilmTable(cal, 4001)
+        # The table as Python lists for _steady_separation_m (np.interp of one value costs ~10 us; this is
+        # called in every substep of a releasing element)
+        self._table_p_Pa = self._film_table.pressure_Pa.tolist()
+        self._table_h_m = self._film_table.separation_m.tolist()
+        self._table_p_min_Pa = self._film_table.pressure_min_Pa
+        self._table_p_max_Pa = self._film_table.pressure_max_Pa
+        # Constants of the per-substep code bound to the element (they were read through self._ph every call):
+        # the same numbers, so the same arithmetic bit for bit. Products are kept in their original left-to-right
+        # order (scale * static_factor * rn * mu2 is the prefix of the static capacity's product).
+        self.film_on = ph.phi != 0.0           # the squeeze film integrated (phi == 0: the steady film at once)
+        self.h_min, self.h_max = ph.h_min, ph.h_max
+        self.area = ph.area
+        self.p_idle = 0.8 * self.p_kiss        # the spring's preload pressure (empty piston)
+        self.static_k = self.scale * ph.static_factor * ph.rn * ph.mu2
+        self.coul_rn = self.scale * ph.rn
+        self.mu1, self.dmu = ph.mu1, ph.dmu
+        self.neg_r_eff, self.vs = -ph.r_eff, ph.vs
+        self.r_over_vs = ph.r_eff / ph.vs
+        self.inv_s_sqrt2, self.pc_area, self.pc_lin, self.hbar_k = ph.inv_s_sqrt2, ph.pc_area, ph.pc_lin, ph.hbar_k
+        self.rate_k = ph.rate_k
+        self.mv = tuple(float(m) for m in ph.mv)
+        self.mu3_th2, self.th1 = ph.mu3_th2, ph.th1
+        self.k1_oil, self.k2_housing, self.k12 = self.k1 * self.oil, self.k2 * self.housing, self.k1 + self.k2
         self.current = 0.0
         self.P = 0.0
         self.p_cmd = 0.0
@@ -94,33 +121,41 @@ class TrueElement:
         full = self.P > self.p_kiss or not self.fill_on
         self.fill = 1.0 if full else 0.0
         f = self._force(self.P) if full else 0.0
-        ph = self._ph
         if f > 0.0:
-            h = float(model.separation_from_pressure_m(self.cal, f / ph.area))
-            self.h = min(max(h, ph.h_min), ph.h_max)
+            h = float(model.separation_from_pressure_m(self.cal, f / self.area))
+            self.h = min(max(h, self.h_min), self.h_max)
         else:
-            self.h = ph.h_max
+            self.h = self.h_max
         self._set_film(self.h)
         self._rest = True
 
     def _set_theta(self, theta):
         ph = self._ph
-        self.mu_v = float(ph.viscosity(theta))
-        self.temp = 1.0 + ph.mu3_th2 * (theta - ph.th1)
+        # _Physics.viscosity (eq. 2) on one float: numpy's exp as there (math.exp differs from it in the last
+        # bit for some arguments), the rest in float arithmetic (the same IEEE operations as on numpy scalars)
+        mv1, mv2, mv3, mv4 = self.mv
+        self.mu_v = mv1 * float(_np_exp(mv2 * theta)) + mv3 * float(_np_exp(mv4 * theta))
+        self.temp = 1.0 + self.mu3_th2 * (theta - self.th1)
         self.rate_mu = ph.rate_k / self.mu_v if ph.phi > 0.0 else 0.0
+        self.visc_mu = self.visc_k * self.mu_v      # _set_open's numerator (visc_k mu_v, in that order)
 
     def _set_film(self, h):
-        ph = self._ph
         if h != self._contact_h:           # the contact depends on h alone (the temperature changes every period)
             self._contact_h = h
-            self.f_c, self.hbar = ph.contact(h)
-        self.static = self.scale * ph.static_factor * ph.rn * ph.mu2 * self.temp * self.f_c
-        self.coul_k = self.scale * ph.rn * self.temp * self.f_c
+            # _Physics.contact(h), inlined (called in every substep of an engaging element)
+            x = h * self.inv_s_sqrt2
+            ex = math.exp(-x * x)
+            self.f_c = self.pc_area * (ex - h * self.pc_lin * math.erfc(x))
+            self.hbar = 0.5 * h * (1.0 + math.erf(x)) + self.hbar_k * ex
+        self.static = self.static_k * self.temp * self.f_c
+        self.coul_k = self.coul_rn * self.temp * self.f_c
+        # kinetic_slope's Stribeck slope factor: -coul_k dmu (r_eff / v_s), in the order it had there
+        self.slope_k = -self.coul_k * self.dmu * self.r_over_vs
         self._set_open()
 
     def _set_open(self):
         """The viscous coefficient with the open clearance, the aeration factor's q = (1 - f) / w_a^2."""
-        self.visc_c = self.visc_k * self.mu_v / (self.hbar + (1.0 - self.fill) * self.open_gap)
+        self.visc_c = self.visc_mu / (self.hbar + (1.0 - self.fill) * self.open_gap)
         self.aer_q = (1.0 - self.fill) * self.inv_wa2
 
     def _force(self, p):
@@ -128,18 +163,36 @@ class TrueElement:
         return f if f > 0.0 else 0.0
 
     def _film_rate(self, h, f_app):
-        ph = self._ph
-        x = h * ph.inv_s_sqrt2
+        x = h * self.inv_s_sqrt2
         ex = math.exp(-x * x)
-        f_c = ph.pc_area * (ex - h * ph.pc_lin * math.erfc(x))
+        f_c = self.pc_area * (ex - h * self.pc_lin * math.erfc(x))
         slope2 = math.erfc(-x)
-        hb = 0.5 * h * slope2 + ph.hbar_k * ex
+        hb = 0.5 * h * slope2 + self.hbar_k * ex
         return self.rate_mu * (f_c - f_app) * (hb * hb * hb / slope2)
 
     def _fill_rate(self, p):
         q = self.fill_gain * (p - self.p_kiss * (0.8 + 0.2 * self.fill))
         m = self.fill_max
         return m if q > m else -m if q < -m else q
+
+    def _steady_separation_m(self, force_N):
+        """The steady film's separation under force_N: FilmTable.separation_from_pressure_m (np.clip, then
+        np.interp) for one value in plain Python, the same arithmetic as numpy's interp (its slope (y1 - y0) /
+        (x1 - x0) times (x - x0) plus y0; a node's own value at a node), so the same number to the bit
+        (tests/python/test_gearbox_plant_speed.py checks it against the table)."""
+        p = force_N / self.area
+        lo, hi = self._table_p_min_Pa, self._table_p_max_Pa
+        p = lo if p < lo else hi if p > hi else p
+        xs, ys = self._table_p_Pa, self._table_h_m
+        if p <= xs[0]:
+            return ys[0]
+        if p >= xs[-1]:
+            return ys[-1]
+        k = bisect.bisect_right(xs, p) - 1          # xs[k] <= p < xs[k + 1]
+        x0 = xs[k]
+        if p == x0:
+            return ys[k]
+        return (ys[k + 1] - ys[k]) / (xs[k + 1] - x0) * (p - x0) + ys[k]
 
     # ------------------------------------------------------------------ the mechanics' view
     def kinetic(self, w_abs: float) -> float:
@@ -152,11 +205,12 @@ class TrueElement:
 
     def kinetic_slope(self, w_abs: float) -> tuple[float, float]:
         """(kinetic(w_abs), slope(w_abs)) with one exponential: the mechanics ask for both every substep."""
-        ph = self._ph
         x = self.aer_q * w_abs * w_abs
-        e = math.exp(-ph.r_eff * w_abs / ph.vs)
-        return (self.coul_k * (ph.mu1 + ph.dmu * e) + self.visc_c * w_abs / (1.0 + x),
-                -self.coul_k * ph.dmu * (ph.r_eff / ph.vs) * e + self.visc_c * (1.0 - x) / ((1.0 + x) * (1.0 + x)))
+        e = math.exp(self.neg_r_eff * w_abs / self.vs)         # e^(-r_eff |w| / v_s)
+        q = 1.0 + x
+        visc_c = self.visc_c
+        return (self.coul_k * (self.mu1 + self.dmu * e) + visc_c * w_abs / q,
+                self.slope_k * e + visc_c * (1.0 - x) / (q * q))
 
     # ------------------------------------------------------------------ one period
     def step_begin(self, current_mA: float) -> None:
@@ -167,60 +221,82 @@ class TrueElement:
         self.p_cmd = self.gain * self.current
         self.dp = self.P - self.p_cmd
         # an empty piston whose pressure stays at or below the spring's preload all period (it moves from P to
-        # p_cmd) and an open film at rest: every substep would leave it as it is (substep's first branches)
-        ph = self._ph
-        self._idle = self.fill_on and self.fill == 0.0 and ph.phi != 0.0 and self.h >= ph.h_max and \
-            max(self.P, self.p_cmd) <= 0.8 * self.p_kiss
+        # p_cmd) and an open film at rest: every substep would leave it as it is (substep's first branches), so
+        # the plant does not call it this period (plant.step)
+        self._idle = self.fill_on and self.fill == 0.0 and self.film_on and self.h >= self.h_max and \
+            max(self.P, self.p_cmd) <= self.p_idle
 
     def substep(self, j: int) -> None:
         """Advance the piston's fill and the film over substep j (the pressure exact within it); the film's
-        torque, capacity and drag updated to its end."""
+        torque, capacity and drag updated to its end. (_force and _fill_rate are inlined here, the hot path; the
+        arithmetic is theirs.)"""
         if self._idle:
             return
         lag = self.lag
-        p0 = self.p_cmd + self.dp * lag[2 * j]
-        pm = self.p_cmd + self.dp * lag[2 * j + 1]
-        p1 = self.p_cmd + self.dp * lag[2 * j + 2]
-        if self.fill_on and (self.fill < 1.0 or pm < self.p_kiss):
-            full0 = self.fill >= 1.0
-            fill = min(max(self.fill + self.hs * self._fill_rate(pm), 0.0), 1.0)
-            if fill != self.fill:
-                self.fill = fill
+        p_cmd, dp = self.p_cmd, self.dp
+        p0 = p_cmd + dp * lag[2 * j]
+        pm = p_cmd + dp * lag[2 * j + 1]
+        p1 = p_cmd + dp * lag[2 * j + 2]
+        a_p, f_s = self.a_p, self.f_s
+        fill = self.fill
+        if self.fill_on and (fill < 1.0 or pm < self.p_kiss):
+            full0 = fill >= 1.0
+            q = self.fill_gain * (pm - self.p_kiss * (0.8 + 0.2 * fill))        # _fill_rate(pm)
+            m = self.fill_max
+            q = m if q > m else -m if q < -m else q
+            new = min(max(fill + self.hs * q, 0.0), 1.0)
+            if new != fill:
+                self.fill = fill = new
                 self._set_open()
             full1 = fill >= 1.0
-            f0 = self._force(p0) if full0 else 0.0
-            fm = self._force(pm) if full1 else 0.0
-            f1 = self._force(p1) if full1 else 0.0
+            if full0:
+                f0 = p0 * a_p - f_s
+                f0 = f0 if f0 > 0.0 else 0.0
+            else:
+                f0 = 0.0
+            if full1:
+                fm = pm * a_p - f_s
+                fm = fm if fm > 0.0 else 0.0
+                f1 = p1 * a_p - f_s
+                f1 = f1 if f1 > 0.0 else 0.0
+            else:
+                fm = f1 = 0.0
         else:
-            f0, fm, f1 = self._force(p0), self._force(pm), self._force(p1)
-        ph = self._ph
+            f0 = p0 * a_p - f_s
+            f0 = f0 if f0 > 0.0 else 0.0
+            fm = pm * a_p - f_s
+            fm = fm if fm > 0.0 else 0.0
+            f1 = p1 * a_p - f_s
+            f1 = f1 if f1 > 0.0 else 0.0
         h = self.h
-        if ph.phi == 0.0:
-            h = float(self._film_table.separation_from_pressure_m(f1 / ph.area))
-        elif h >= ph.h_max and f0 == 0.0 and f1 == 0.0:
+        tol = FILM_AT_REST * (f1 if f1 > 1.0 else 1.0)         # FILM_AT_REST x max(f1, 1)
+        if not self.film_on:
+            h = self._steady_separation_m(f1)
+        elif h >= self.h_max and f0 == 0.0 and f1 == 0.0:
             return
-        elif self._rest and abs(f1 - f0) <= FILM_AT_REST * max(f1, 1.0) \
-                and abs(self.f_c - f1) <= FILM_AT_REST * max(f1, 1.0):
+        elif self._rest and abs(f1 - f0) <= tol and abs(self.f_c - f1) <= tol:
             return
         elif fm <= self.f_c:
-            h = max(h, float(self._film_table.separation_from_pressure_m(f1 / ph.area)))
+            h_ss = self._steady_separation_m(f1)
+            h = h if h >= h_ss else h_ss
         else:
             hs = self.hs
-            k1 = self._film_rate(h, f0)
-            k2 = self._film_rate(h + 0.5 * hs * k1, fm)
-            k3 = self._film_rate(h + 0.5 * hs * k2, fm)
-            k4 = self._film_rate(h + hs * k3, f1)
-            h = min(max(h + (hs / 6.0) * (k1 + 2.0 * (k2 + k3) + k4), ph.h_min), ph.h_max)
+            rate = self._film_rate
+            k1 = rate(h, f0)
+            k2 = rate(h + 0.5 * hs * k1, fm)
+            k3 = rate(h + 0.5 * hs * k2, fm)
+            k4 = rate(h + hs * k3, f1)
+            h = min(max(h + (hs / 6.0) * (k1 + 2.0 * (k2 + k3) + k4), self.h_min), self.h_max)
         if h != self.h:
             self.h = h
             self._set_film(h)
-        self._rest = abs(self.f_c - f1) <= FILM_AT_REST * max(f1, 1.0)
+        self._rest = abs(self.f_c - f1) <= tol
 
     def step_end(self, friction_energy_J: float, dt_s: float) -> None:
         """The pressure at the period's end; the pack's heat from the period's friction energy (eq. 1)."""
         self.P = self.p_cmd + self.dp * self.lag[-1]
-        self.power = friction_energy_J / dt_s
-        th_ss = (self.power + self.k1 * self.oil + self.k2 * self.housing) / (self.k1 + self.k2)
+        self.power = power = friction_energy_J / dt_s
+        th_ss = (power + self.k1_oil + self.k2_housing) / self.k12
         theta = th_ss + (self.theta - th_ss) * self.a_th
         if theta != self.theta:
             self.theta = theta

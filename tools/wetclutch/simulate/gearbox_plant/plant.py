@@ -3,6 +3,7 @@ mechanics module the constrained step and the stick-slip rules)."""
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
@@ -77,6 +78,7 @@ class Plant8:
         dl = self.dl
         self.R_all = np.vstack([dl.engine_row, dl.input_row, dl.wheel_row, dl.shaft_row, dl.output_row, self.rows])
         self.R_allT = self.R_all.T.copy()
+        self._out_row = self.R_all[OUT_ROW].copy()      # the output speed's row (the same numbers as R_all's)
         m_inv = np.linalg.inv(dl.M)
         self.mob = [float(r @ m_inv @ r) for r in self.rows]     # unconstrained slip mobility per joint
         self.ks, self.cs = v.shaft_stiffness, v.shaft_damping
@@ -89,6 +91,8 @@ class Plant8:
         self.road_drag = v.wheel_radius ** 3 * 0.5 * v.air_density * v.drag_area
         self.ratios = kinematics.check(self.gb)
         n_j = len(self.joints)
+        self.n_u, self.n_all = self.dl.n, self.R_all.shape[0]      # sizes the substep reads every time
+        self._joint_zeros = [0.0] * n_j                             # f's joint entries before the friction
         self.locked = [False] * n_j
         self.dir = [1.0] * n_j
         self.cand = [False] * n_j
@@ -103,6 +107,7 @@ class Plant8:
         self.e_joint = [0.0] * n_j          # friction energy per joint (elements, lock-up, brake), J
         self.ke0 = self.pe0 = 0.0
         self._last = {}
+        self._sp_of_u = (None, None)        # (u, (R_all @ u).tolist()) as truth.state_of left it
         self.recorder = Recorder(self, keep=record)   # a drive cycle keeps its own (1.8 M periods)
 
     # ------------------------------------------------------------------ initialisers
@@ -168,12 +173,12 @@ class Plant8:
         self.accel = self.rw * float(acc[-1])
         for k, lk in zip(idx, lam[:-1]):
             self.torque[k] = -float(lk)
-        for k, (d, tk, _) in parts["fric"].items():
+        for k, (d, tk, _) in parts[-1].items():
             self.torque[k] = d * tk
         self.jerk = 0.0
         self.ke0 = self.dl.kinetic_energy(self.u)
         self.pe0 = 0.5 * self.ks * self.phi ** 2
-        self._last = {"t_s_Nm": t_s, "road": parts["t_road"],
+        self._last = {"t_s_Nm": t_s, "road": parts[3],
                       "out_Nm": t_s + self.J_out * float(self.dl.output_row @ acc)}
         self._state = self.recorder.append()
 
@@ -210,7 +215,9 @@ class Plant8:
 
     def _applied(self, sp, locked, h, k_half, with_shaft=True):
         """The applied torques at the speeds sp = R_all u, as the factors f of R_all's rows (Q = R_all^T f);
-        the slipping joints to take implicitly [(k, slope)]; the parts the bookkeeping needs."""
+        the slipping joints to take implicitly [(k, slope)]; the parts the bookkeeping needs, a plain tuple
+        (t_e, t_p, t_tb, t_road, t_s0, fric) (a dict cost more than the rest of the bookkeeping): the engine's,
+        pump's, turbine's, road's and driveshaft's torques, fric {slipping joint: (direction, |T|, slope)}."""
         eng = self.engine
         w_e, w_t, w_w, gu = sp[0], sp[1], sp[2], sp[3]
         t_ind = eng.t_ind if k_half is None else eng.indicated_at(k_half)
@@ -218,33 +225,32 @@ class Plant8:
         t_p, t_tb = self.converter.torques(w_e, w_t)
         t_road = self._road(w_w)
         t_s0 = self.ks * self.phi + self.ch * gu if with_shaft else 0.0
-        f = [t_e - t_p, t_tb, -t_road, -t_s0, 0.0] + [0.0] * len(self.joints)
+        f = [t_e - t_p, t_tb, -t_road, -t_s0, 0.0] + self._joint_zeros
         implicit = []
         fric = {}
+        dirs, mob = self.dir, self.mob
         for k, joint in enumerate(self.joints):
             if locked[k]:
                 continue
             sk = sp[J0 + k]
-            d = self.dir[k] if abs(sk) <= TINY_SLIP else (1.0 if sk > 0.0 else -1.0)
             w = abs(sk)
+            d = dirs[k] if w <= TINY_SLIP else (1.0 if sk > 0.0 else -1.0)
             tk, slope = joint.kinetic_slope(w)
             f[J0 + k] = -d * tk
-            if slope > 0.0 and h * slope * self.mob[k] > IMPLICIT_STIFFNESS:
+            if slope > 0.0 and h * slope * mob[k] > IMPLICIT_STIFFNESS:
                 implicit.append((k, slope))
                 fric[k] = (d, tk, slope)
             else:
                 fric[k] = (d, tk, 0.0)
-        parts = {"t_e": t_e, "t_ind": t_ind, "t_p": t_p, "t_tb": t_tb, "t_road": t_road, "t_s0": t_s0,
-                 "fric": fric}
-        return f, implicit, parts
+        return f, implicit, (t_e, t_p, t_tb, t_road, t_s0, fric)
 
     def _constrained(self, u0, sp, locked, f, implicit, h):
         """(du, dsp, lam, idx): the constrained step (mechanics docstring) with the locked joints idx: the change
         of u, of the speeds R_all u, and the reactions. Without implicit joints the linear map from (f, the
         locked slips) to all three is cached per locked set (M, h and the driveshaft are constant)."""
-        idx = [k for k, lk in enumerate(locked) if lk]
-        n = self.dl.n
+        n = self.n_u
         if implicit:
+            idx = [k for k, lk in enumerate(locked) if lk]
             K = self.K0.copy()
             for k, slope in implicit:
                 r = self.rows[k]
@@ -253,15 +259,18 @@ class Plant8:
                                       np.array([-sp[J0 + k] for k in idx]))
             return du, (self.R_all @ du).tolist(), (lam / h).tolist(), idx
         key = tuple(locked)
-        z = self._kkt_cache.get(key)
-        if z is None:
-            z = self._kkt_map(idx, h)
+        cached = self._kkt_cache.get(key)
+        if cached is None:
+            idx = [k for k, lk in enumerate(locked) if lk]
+            cached = (self._kkt_map(idx, h), idx)      # idx with it: the callers only read it
             if len(self._kkt_cache) > 256:
                 self._kkt_cache.clear()
-            self._kkt_cache[key] = z
+            self._kkt_cache[key] = cached
+        z, idx = cached
         x = z @ np.array(f + [-sp[J0 + k] for k in idx])
-        n_all = self.R_all.shape[0]
-        return x[:n], x[n:n + n_all].tolist(), x[n + n_all:].tolist(), idx
+        n_all = self.n_all
+        xl = x.tolist()         # one conversion for both lists (slicing the list gives the same numbers)
+        return x[:n], xl[n:n + n_all], xl[n + n_all:], idx
 
     def _kkt_map(self, idx, h):
         """Z with [du; R_all du; lam] = Z [f; -B u0] for the locked rows idx (K = K0)."""
@@ -316,60 +325,67 @@ class Plant8:
     def _substep(self, j, fric_e):
         h = self.hs
         self.lockup.at(2 * j)
-        if any(self.cand):
+        if True in self.cand:                   # any(self.cand): a candidate to lock
             for k, loss in self._try_lock(2 * j + 1).items():
                 fric_e[k] += loss
         u0 = self.u
-        sp = (self.R_all @ u0).tolist()
-        f, implicit, parts = self._applied(sp, self.locked, h, 2 * j + 1)
+        # R_all u0: state_of computed it already for the u the last period ended with (u is only ever
+        # replaced, never changed in place, so the same object is the same speeds)
+        u_known, sp = self._sp_of_u
+        if u_known is not u0:
+            sp = (self.R_all @ u0).tolist()
+        locked = self.locked                    # the list itself: a break-loose below updates self.locked
+        joints = self.joints
+        f, implicit, parts = self._applied(sp, locked, h, 2 * j + 1)
+        t_e, t_p, t_tb, t_road, t_s0, fric = parts
         while True:
-            du, dsp, lam, idx = self._constrained(u0, sp, self.locked, f, implicit, h)
+            du, dsp, lam, idx = self._constrained(u0, sp, locked, f, implicit, h)
             worst, ratio, sign = None, 1.0, 0.0
             for k, lk in zip(idx, lam):
-                cap = self.joints[k].static
-                r = abs(lk) / cap if cap > 0.0 else (math.inf if lk != 0.0 else 0.0)
+                cap = joints[k].static
+                a = abs(lk)
+                if a <= cap:        # within its capacity: the ratio below would be <= 1, never the worst
+                    continue
+                r = a / cap if cap > 0.0 else (math.inf if lk != 0.0 else 0.0)
                 if r > ratio:
                     worst, ratio, sign = k, r, lk
             if worst is None:
                 break
             # breaks loose, slipping against its reaction, at the kinetic torque of zero slip
-            self.locked[worst] = False
+            locked[worst] = False
             d = -1.0 if sign > 0.0 else 1.0
             self.dir[worst] = d
-            joint = self.joints[worst]
+            joint = joints[worst]
             tk, slope = joint.kinetic(0.0), joint.slope(0.0)
             f[J0 + worst] = -d * tk
             if slope > 0.0 and h * slope * self.mob[worst] > IMPLICIT_STIFFNESS:
                 implicit.append((worst, slope))
-                parts["fric"][worst] = (d, tk, slope)
+                fric[worst] = (d, tk, slope)
             else:
-                parts["fric"][worst] = (d, tk, 0.0)
+                fric[worst] = (d, tk, 0.0)
         u1 = u0 + du
-        sp1 = [a + b for a, b in zip(sp, dsp)]
+        sp1 = list(map(operator.add, sp, dsp))      # sp + dsp element by element
         gu0, gu1 = sp[3], sp1[3]
-        t_s = parts["t_s0"] + self.ch * (gu1 - gu0)
+        t_s = t_s0 + self.ch * (gu1 - gu0)
         self.phi += h * gu1
         gum = 0.5 * (gu0 + gu1)
         w_e_m, w_t_m, w_w_m = 0.5 * (sp[0] + sp1[0]), 0.5 * (sp[1] + sp1[1]), 0.5 * (sp[2] + sp1[2])
         e = self.e
-        e["engine"] += parts["t_e"] * w_e_m * h
-        e["converter"] += (parts["t_p"] * w_e_m - parts["t_tb"] * w_t_m) * h
-        e["road"] += parts["t_road"] * w_w_m * h
+        e["engine"] += t_e * w_e_m * h
+        e["converter"] += (t_p * w_e_m - t_tb * w_t_m) * h
+        e["road"] += t_road * w_w_m * h
         e["damping"] += self.cs * gum * gum * h
-        fric = parts["fric"]
-        for k in range(len(self.joints)):
+        torque, dirs, cand = self.torque, self.dir, self.cand
+        for k, (d, tk, slope) in fric.items():      # the slipping joints (fric holds exactly those)
             a, b = sp[J0 + k], sp1[J0 + k]
-            if self.locked[k]:
-                continue
-            d, tk, slope = fric[k]
             fa = -d * tk - slope * (b - a)           # the applied (linearly implicit) torque along the row
-            self.torque[k] = -fa
+            torque[k] = -fa
             fric_e[k] -= fa * 0.5 * (a + b) * h
             if abs(b) > TINY_SLIP:
-                self.dir[k] = 1.0 if b > 0.0 else -1.0
-            self.cand[k] = (a * b <= 0.0 and a != 0.0) or abs(b) < LOCK_BAND
+                dirs[k] = 1.0 if b > 0.0 else -1.0
+            cand[k] = (a * b <= 0.0 and a != 0.0) or abs(b) < LOCK_BAND
         for k, lk in zip(idx, lam):
-            self.torque[k] = -lk
+            torque[k] = -lk
         self.u = u1
         self._sp = sp1
         return parts, t_s
@@ -411,33 +427,41 @@ class Plant8:
             if not math.isfinite(float(val)):
                 raise ValueError(f"{name} {val!r} is not finite")
         pedal = min(max(float(pedal), 0.0), 1.0)
-        self.engine.step_begin(float(self.u[0]), pedal, float(engine_delta_Nm))
-        for name, el in zip(self.names, self.elements):
+        u = self.u
+        self.engine.step_begin(float(u[0]), pedal, float(engine_delta_Nm))
+        elements = self.elements
+        for name, el in zip(self.names, elements):
             el.step_begin(cur[name])
         self.lockup.step_begin(lockup_current_mA)
         self.brake.set(brake_Nm)
         fric_e = [0.0] * len(self.joints)
-        w_w0 = float(self.u[-1])
-        w_o0 = float(self.R_all[OUT_ROW] @ self.u)
+        w_w0 = float(u[-1])
+        w_o0 = float(self._out_row @ u)
         t_s_sum = 0.0
+        # the elements whose substeps would change something (TrueElement.step_begin's _idle: the others'
+        # substeps return at once, all period)
+        busy = [el for el in elements if not el._idle]
+        substep = self._substep
         for j in range(self.n_sub):
-            parts, t_s = self._substep(j, fric_e)
+            parts, t_s = substep(j, fric_e)
             t_s_sum += t_s
-            for el in self.elements:
+            for el in busy:
                 el.substep(j)
         self.engine.step_end()
         self.lockup.step_end()
-        for k, el in enumerate(self.elements):
-            el.step_end(fric_e[k], self.dt)
-        for k in range(len(self.joints)):
-            self.e_joint[k] += fric_e[k]
-        self.t += self.dt
-        accel = self.rw * (float(self.u[-1]) - w_w0) / self.dt
-        self.jerk = (accel - self.accel) / self.dt
+        dt = self.dt
+        e_joint = self.e_joint
+        for k, el in enumerate(elements):
+            el.step_end(fric_e[k], dt)
+        for k, e in enumerate(fric_e):
+            e_joint[k] += e
+        self.t += dt
+        accel = self.rw * (float(self.u[-1]) - w_w0) / dt
+        self.jerk = (accel - self.accel) / dt
         self.accel = accel
         t_s_mean = t_s_sum / self.n_sub
-        self._last = {"t_s_Nm": t_s_mean, "road": parts["t_road"],
-                      "out_Nm": t_s_mean + self.J_out * (self._sp[OUT_ROW] - w_o0) / self.dt}
+        self._last = {"t_s_Nm": t_s_mean, "road": parts[3],
+                      "out_Nm": t_s_mean + self.J_out * (self._sp[OUT_ROW] - w_o0) / dt}
         self._state = self.recorder.append()
         return dict(self._state)
 

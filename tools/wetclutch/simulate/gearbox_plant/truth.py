@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 RPM = math.pi / 30.0
+J0 = 5          # the joints' slips in R_all u follow engine, input, wheel, driveshaft and output (plant.J0)
 
 STATE_DOC = {
     "t_s": "s, plant time (0 at the initialiser)",
@@ -48,7 +49,9 @@ ELEMENT_CHANNELS = ("slip_rad_s", "torque_Nm", "capacity_Nm", "locked", "current
 
 
 def state_of(plant) -> dict:
-    sp = (plant.R_all @ plant.u).tolist()       # engine, input, wheel, driveshaft, output, joints' slips
+    u = plant.u
+    sp = (plant.R_all @ u).tolist()             # engine, input, wheel, driveshaft, output, joints' slips
+    plant._sp_of_u = (u, sp)                    # the next period's first substep starts from the same speeds
     w_e, w_t, w_w, w_o = sp[0], sp[1], sp[2], sp[4]
     eng = plant.engine
     t_p, t_tb = plant.converter.torques(w_e, w_t)
@@ -83,19 +86,25 @@ def state_of(plant) -> dict:
         "brake_locked": float(plant.locked[-1]),
         "gear_ratio_actual": w_t / w_o if w_o != 0.0 else math.nan,
     }
-    s = sp[5:]
-    for k, (name, el) in enumerate(zip(plant.names, plant.elements)):
-        st[f"{name}_slip_rad_s"] = float(s[k])
-        st[f"{name}_torque_Nm"] = float(plant.torque[k])
-        st[f"{name}_capacity_Nm"] = el.static
-        st[f"{name}_locked"] = float(plant.locked[k])
-        st[f"{name}_current_mA"] = el.current
-        st[f"{name}_pressure_Pa"] = el.chamber_pressure()
-        st[f"{name}_fill"] = el.fill
-        st[f"{name}_theta_degC"] = el.theta
-        st[f"{name}_power_W"] = el.power
-        st[f"{name}_energy_J"] = plant.e_joint[k]
+    keys = _element_keys(plant.names)
+    torque, locked, e_joint = plant.torque, plant.locked, plant.e_joint
+    for k, el in enumerate(plant.elements):
+        st.update(zip(keys[k], (                # ELEMENT_CHANNELS' order
+            float(sp[J0 + k]), float(torque[k]), el.static, float(locked[k]), el.current, el.chamber_pressure(),
+            el.fill, el.theta, el.power, e_joint[k])))
     return st
+
+
+_KEYS: dict = {}
+
+
+def _element_keys(names: tuple) -> list:
+    """Per element its channels' names (NAME_slip_rad_s ...), made once per set of names: formatting them every
+    period cost as much as the rest of state_of."""
+    keys = _KEYS.get(names)
+    if keys is None:
+        keys = _KEYS[names] = [tuple(f"{name}_{c}" for c in ELEMENT_CHANNELS) for name in names]
+    return keys
 
 
 class Recorder:
