@@ -103,6 +103,7 @@ class TrueElement:
         self.theta = self.oil
         self.power = 0.0
         self._contact_h = math.nan
+        self._contact_x = self._contact_ex = math.nan
         self._idle = False
         self._set_theta(self.theta)
         self._set_film(self.h)
@@ -147,11 +148,15 @@ class TrueElement:
             ex = math.exp(-x * x)
             self.f_c = self.pc_area * (ex - h * self.pc_lin * math.erfc(x))
             self.hbar = 0.5 * h * (1.0 + math.erf(x)) + self.hbar_k * ex
+            self._contact_x, self._contact_ex = x, ex      # the next RK4's first stage starts at this h
         self.static = self.static_k * self.temp * self.f_c
         self.coul_k = self.coul_rn * self.temp * self.f_c
         # kinetic_slope's Stribeck slope factor: -coul_k dmu (r_eff / v_s), in the order it had there
         self.slope_k = -self.coul_k * self.dmu * self.r_over_vs
-        self._set_open()
+        # _set_open(), inlined (this runs in every substep that moves the film)
+        open_share = 1.0 - self.fill
+        self.visc_c = self.visc_mu / (self.hbar + open_share * self.open_gap)
+        self.aer_q = open_share * self.inv_wa2
 
     def _set_open(self):
         """The viscous coefficient with the open clearance, the aeration factor's q = (1 - f) / w_a^2."""
@@ -282,7 +287,15 @@ class TrueElement:
         else:
             hs = self.hs
             rate = self._film_rate
-            k1 = rate(h, f0)
+            if h == self._contact_h:
+                # _film_rate(h, f0) from _set_film's contact at this h (the same x, e^(-x^2) and F_c(h): the
+                # same expressions); only 1 + erf x = erfc(-x) is new
+                x, ex = self._contact_x, self._contact_ex
+                slope2 = math.erfc(-x)
+                hb = 0.5 * h * slope2 + self.hbar_k * ex
+                k1 = self.rate_mu * (self.f_c - f0) * (hb * hb * hb / slope2)
+            else:
+                k1 = rate(h, f0)
             k2 = rate(h + 0.5 * hs * k1, fm)
             k3 = rate(h + 0.5 * hs * k2, fm)
             k4 = rate(h + hs * k3, f1)

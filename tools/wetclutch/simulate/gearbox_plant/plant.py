@@ -262,12 +262,18 @@ class Plant8:
         cached = self._kkt_cache.get(key)
         if cached is None:
             idx = [k for k, lk in enumerate(locked) if lk]
-            cached = (self._kkt_map(idx, h), idx)      # idx with it: the callers only read it
+            z = self._kkt_map(idx, h)
+            # the columns of the locked slips negated (exact), so the slips go in as they are: Z [f; -s] =
+            # Z' [f; s] to the bit (each product only changes sign)
+            z[:, len(f):] *= -1.0
+            slips = operator.itemgetter(*(J0 + k for k in idx)) if len(idx) > 1 else \
+                (lambda s, i=J0 + idx[0]: (s[i],)) if idx else (lambda s: ())
+            cached = (z, idx, slips)        # idx with it: the callers only read it
             if len(self._kkt_cache) > 256:
                 self._kkt_cache.clear()
             self._kkt_cache[key] = cached
-        z, idx = cached
-        x = z @ np.array(f + [-sp[J0 + k] for k in idx])
+        z, idx, slips = cached
+        x = z @ np.array([*f, *slips(sp)])
         n_all = self.n_all
         xl = x.tolist()         # one conversion for both lists (slicing the list gives the same numbers)
         return x[:n], xl[n:n + n_all], xl[n + n_all:], idx
