@@ -104,6 +104,8 @@ class TrueElement:
         self.power = 0.0
         self._contact_h = math.nan
         self._contact_x = self._contact_ex = math.nan
+        self._hbar_h = math.nan             # the h of _hbar (_kinetic_terms)
+        self._kinetic_stale = True
         self._idle = False
         self._set_theta(self.theta)
         self._set_film(self.h)
@@ -138,30 +140,67 @@ class TrueElement:
         self.mu_v = mv1 * float(_np_exp(mv2 * theta)) + mv3 * float(_np_exp(mv4 * theta))
         self.temp = 1.0 + self.mu3_th2 * (theta - self.th1)
         self.rate_mu = ph.rate_k / self.mu_v if ph.phi > 0.0 else 0.0
-        self.visc_mu = self.visc_k * self.mu_v      # _set_open's numerator (visc_k mu_v, in that order)
+        self.visc_mu = self.visc_k * self.mu_v      # the viscous coefficient's numerator (in this order)
+        self._kinetic_stale = True
 
     def _set_film(self, h):
         if h != self._contact_h:           # the contact depends on h alone (the temperature changes every period)
             self._contact_h = h
-            # _Physics.contact(h), inlined (called in every substep of an engaging element)
+            # _Physics.contact(h)'s F_c, inlined (called in every substep of an engaging element); its h_bar in
+            # _kinetic_terms
             x = h * self.inv_s_sqrt2
             ex = math.exp(-x * x)
             self.f_c = self.pc_area * (ex - h * self.pc_lin * math.erfc(x))
-            self.hbar = 0.5 * h * (1.0 + math.erf(x)) + self.hbar_k * ex
             self._contact_x, self._contact_ex = x, ex      # the next RK4's first stage starts at this h
         self.static = self.static_k * self.temp * self.f_c
-        self.coul_k = self.coul_rn * self.temp * self.f_c
-        # kinetic_slope's Stribeck slope factor: -coul_k dmu (r_eff / v_s), in the order it had there
-        self.slope_k = -self.coul_k * self.dmu * self.r_over_vs
-        # _set_open(), inlined (this runs in every substep that moves the film)
-        open_share = 1.0 - self.fill
-        self.visc_c = self.visc_mu / (self.hbar + open_share * self.open_gap)
-        self.aer_q = open_share * self.inv_wa2
+        self._kinetic_stale = True
 
     def _set_open(self):
-        """The viscous coefficient with the open clearance, the aeration factor's q = (1 - f) / w_a^2."""
-        self.visc_c = self.visc_mu / (self.hbar + (1.0 - self.fill) * self.open_gap)
-        self.aer_q = (1.0 - self.fill) * self.inv_wa2
+        """The fill changed: the viscous coefficient and the aeration factor are to be made again."""
+        self._kinetic_stale = True
+
+    def _kinetic_terms(self):
+        """The kinetic torque's coefficients from the film, the temperature and the fill as they are now: h_bar
+        (eq. 9), the Coulomb factor, the Stribeck slope factor, the viscous coefficient with the open clearance
+        and the aeration factor's q = (1 - f) / w_a^2. Made when the mechanics next ask (kinetic_slope), not at
+        every change of the film: a locked element's film moves every substep but its kinetic torque is not
+        read. The same expressions from the same values as when they were made at each change (every change of
+        h, theta or the fill marks them stale), so the same numbers."""
+        h = self._contact_h
+        if self._hbar_h != h:
+            self._hbar = 0.5 * h * (1.0 + math.erf(self._contact_x)) + self.hbar_k * self._contact_ex
+            self._hbar_h = h
+        coul_k = self._coul_k = self.coul_rn * self.temp * self.f_c
+        self._slope_k = -coul_k * self.dmu * self.r_over_vs         # -coul_k dmu (r_eff / v_s)
+        open_share = 1.0 - self.fill
+        self._visc_c = self.visc_mu / (self._hbar + open_share * self.open_gap)
+        self._aer_q = open_share * self.inv_wa2
+        self._kinetic_stale = False
+
+    # the coefficients for a reader outside the mechanics (as attributes before they were made on demand)
+    @property
+    def hbar(self) -> float:
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        return self._hbar
+
+    @property
+    def coul_k(self) -> float:
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        return self._coul_k
+
+    @property
+    def visc_c(self) -> float:
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        return self._visc_c
+
+    @property
+    def aer_q(self) -> float:
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        return self._aer_q
 
     def _force(self, p):
         f = p * self.a_p - self.f_s
@@ -210,12 +249,14 @@ class TrueElement:
 
     def kinetic_slope(self, w_abs: float) -> tuple[float, float]:
         """(kinetic(w_abs), slope(w_abs)) with one exponential: the mechanics ask for both every substep."""
-        x = self.aer_q * w_abs * w_abs
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        x = self._aer_q * w_abs * w_abs
         e = math.exp(self.neg_r_eff * w_abs / self.vs)         # e^(-r_eff |w| / v_s)
         q = 1.0 + x
-        visc_c = self.visc_c
-        return (self.coul_k * (self.mu1 + self.dmu * e) + visc_c * w_abs / q,
-                self.slope_k * e + visc_c * (1.0 - x) / (q * q))
+        visc_c = self._visc_c
+        return (self._coul_k * (self.mu1 + self.dmu * e) + visc_c * w_abs / q,
+                self._slope_k * e + visc_c * (1.0 - x) / (q * q))
 
     # ------------------------------------------------------------------ one period
     def step_begin(self, current_mA: float) -> None:
