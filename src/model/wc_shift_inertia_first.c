@@ -398,8 +398,12 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
     /* the turbine running past synchronism (slip > 0: the off-going clutch lets go while T_t still drives) is
      * taken by the on-coming clutch in closed loop (the torque-first shift's flare correction, DESIGN 14) */
     /* (after a coast downshift T_t < 0 drags the turbine back below synchronism: the slip past it is
-     * negative, and the on-coming clutch holds it the same way) */
-    const float past_signed_rad_s = engine ? -slip_rad_s : slip_rad_s;
+     * negative, and the on-coming clutch holds it the same way; a coast downshift requested while the engine
+     * drives, T_t0 > 0 (the pedal pressed, or the open converter's creep while braking to a stop), runs the
+     * turbine up past synchronism once the off-going element has let go, as a kickdown's: the slip past it is
+     * positive (8-speed 2->1 at 5 km/h, brake 700 N m, creep 33 N m: held only against a drag, the turbine
+     * ran 560 rpm past and the lock-up failed) */
+    const float past_signed_rad_s = engine ? fabsf(slip_rad_s) : slip_rad_s;
     const float past_rad_s = (past_signed_rad_s > 0.0f) ? past_signed_rad_s : 0.0f;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
         const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * past_rad_s * dt_s;

@@ -252,19 +252,20 @@ def run_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, o
 
 def trace_shift(vehicle, source: int, target: int, kind: str, load: float = 1.0, oil_degC: float = OIL_DEGC,
                 seed: int = 1, lib=None, fault=None, pedal=None, lockup_current_mA: float = LOCKUP_MA,
-                rpm=None) -> ShiftTrace:
+                rpm=None, brake_Nm: float = 0.0) -> ShiftTrace:
     """run_shift's run with its per-period traces (ShiftTrace: its .quality is run_shift's dict). fault: (phase
     of PHASES, offset_s, duration_s): both speeds lost (NaN, the loop's safe state) from offset_s after the TCU
     first reports the phase, for duration_s (faults8). pedal, rpm: instead of the kind's scenario's (SCENARIOS);
-    lockup_current_mA: the converter's lock-up clutch (0: open, as the WLTC's low gears)."""
+    lockup_current_mA: the converter's lock-up clutch (0: open, as the WLTC's low gears); brake_Nm: the wheel
+    brake's torque throughout (the drive cycle's coast downshifts while braking to a stop)."""
     return _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu=True, fault=fault,
-                     pedal=pedal, lockup_current_mA=lockup_current_mA, rpm=rpm)
+                     pedal=pedal, lockup_current_mA=lockup_current_mA, rpm=rpm, brake_Nm=brake_Nm)
 
 
 def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu: bool, fault=None, pedal=None,
-              lockup_current_mA: float = LOCKUP_MA, rpm=None) -> ShiftTrace:
+              lockup_current_mA: float = LOCKUP_MA, rpm=None, brake_Nm: float = 0.0) -> ShiftTrace:
     """The closed loop of run_shift; keep_tcu: the TCU's outputs kept per period (else ShiftTrace.tcu is empty);
-    fault, pedal, lockup_current_mA, rpm: trace_shift's."""
+    fault, pedal, lockup_current_mA, rpm, brake_Nm: trace_shift's."""
     if fault is not None and fault[0] not in PHASES:
         raise ShiftError(f"fault: phase {fault[0]!r} is not one of {PHASES}")
     params, _models = _plant_and_models(str(plant_path(vehicle)))
@@ -279,7 +280,8 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
     ratio_src = float(kinematics.ratio(params.gearbox, src))
     ratio_tgt = float(kinematics.ratio(params.gearbox, tgt))
     speed = rpm * RPM / ratio_src / v.final_drive * v.wheel_radius
-    plant = Plant8.in_gear(params, src, speed, pedal=pedal, lockup_current_mA=lockup_current_mA, oil_degC=oil_degC)
+    plant = Plant8.in_gear(params, src, speed, pedal=pedal, lockup_current_mA=lockup_current_mA, oil_degC=oil_degC,
+                           brake_Nm=brake_Nm)
     tx = Transmission(params.gearbox.path, source, oil_degC, lib)
     rng = np.random.default_rng(seed)
     dt, n_pre = plant.dt, int(round(v.preroll_time / plant.dt))
@@ -313,7 +315,7 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
             tcu_rows.append(_tcu_row(o))
         if o.ended and end_k is None:
             end_k, report = k, list(o.report)
-        st = plant.step(currents, lockup_current_mA, pedal, engine_delta)
+        st = plant.step(currents, lockup_current_mA, pedal, engine_delta, brake_Nm)
         if end_k is not None and k >= end_k + int(round(AFTER_S / dt)):
             break
     truth = plant.record()
