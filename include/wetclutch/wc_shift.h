@@ -124,8 +124,7 @@ typedef struct wc_shift_calibration {
     uint32_t coordinator;
     float offgoing_ratio;              /* b1 = i1: the off-going clutch's slip a w_t - b1 w_o (1st gear); > output_ratio */
     float fill_pulse_current_mA;       /* fill: this VFS current for fill_pulse_time_s, then the kiss point */
-    float fill_pulse_time_s;           /* <= prepare_time_s; the transmission (wc_transmission.h) ends it
-                                        * sooner, when its lagged pressure reaches the element's kiss pressure */
+    float fill_pulse_time_s;           /* <= prepare_time_s */
     float offgoing_holding_factor;     /* off-going capacity request before the torque phase / T_t */
     float offgoing_margin_factor;      /* torque phase: request = carried torque + factor * T_t0 (+ its lock-up margin) */
     float offgoing_lag_compensation_time_s;  /* the off-going clutch's lag compensation (DESIGN 9); 0: off */

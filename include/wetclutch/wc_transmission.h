@@ -14,10 +14,6 @@
  *   power-off upshift (tip-out)   inertia-first   mirrored  WC_SHIFT_INERTIA_FIRST_ASSIST: the on-coming
  *                                                           element's push
  *
- * The shift calibration is the caller's but for the fill pulse, which ends
- * when its lagged pressure reaches the on-coming element's kiss pressure
- * (F_s / A_p, the element's own VFS and spring), within fill_pulse_time_s.
- *
  * Mirrored: the controller sees every speed, slip and torque negated (the
  * driveline's equations are odd in them, so a tip-out is a kickdown's
  * dynamics with the turbine torque -T_t >= 0, DESIGN 15); the engine request
@@ -121,7 +117,6 @@ typedef struct {
      * calibration's adaptation is 1. The inertia-first types do not learn yet. */
     wc_adapt_values_t learned[WC_GEARBOX_ELEMENTS_MAX];
     wc_adapt_t adapt;
-    float fill_pulse_s[WC_GEARBOX_ELEMENTS_MAX];  /* DESIGN 15: each element's fill pulse (its kiss pressure), at init */
 } wc_transmission_t;
 
 /* In a gear the closed elements are held at the inverse at zero slip; a gear

@@ -5,7 +5,6 @@
 #include <string.h>
 
 #include "wc_internal.h"
-#include "wc_shift_internal.h"
 
 /* The holding's limits (wc_transmission_config_t). */
 #define HOLDING_MARGIN_MAX 5.0f
@@ -50,32 +49,6 @@ wc_cal_error_t wc_transmission_equivalent(const wc_calibration_t *element, float
     return wc_calibration_check(out);
 }
 
-/* DESIGN 15, the fill pulse fit to the on-coming element (its own VFS and return spring): the pulse ends in the
- * period its lagged pressure K i (1 - d^k) (DESIGN 9's VFS lag from rest, d = e^(-dt/tau)) reaches the
- * element's kiss pressure F_s / A_p, within the calibration's fill_pulse_time_s. Longer, the VFS is above the
- * kiss pressure when the piston touches and the pack bites at the whole slip with that force: on the 8-speed
- * plant 300 mA for 20 ms left 196 kPa against 119 (D's 30..50 N m at once in a 3->4 at 25 % load, which the
- * off-going C fought: tie-up 63 %, 21 % with the pulse ended at 12 ms). The 1->2 family's single-clutch
- * shift keeps its calibration's pulse (its fill was tuned with it). Bounded: at most the pulse's periods; once per
- * element at init (wc_transmission_t.fill_pulse_s), not in a step. */
-static float fill_pulse_to_kiss_s(const wc_shift_calibration_t *cal, const wc_model_t *element)
-{
-    const wc_calibration_t *c = element->cal;
-    const float dt_s = c->control_period_s;
-    const uint32_t n_max = wc_shift_periods_of(cal->fill_pulse_time_s, dt_s);
-    const float i = cal->fill_pulse_current_mA;
-    const float i_mA = (i < c->vfs_current_min_mA) ? c->vfs_current_min_mA : ((i > c->vfs_current_max_mA) ? c->vfs_current_max_mA : i);
-    const float target_Pa = c->vfs_gain_Pa_per_mA * i_mA;
-    const float kiss_Pa = c->return_spring_force_N / c->piston_area_m2;
-    float built_Pa = 0.0f;
-    uint32_t n = 0u;
-    while ((n < n_max) && (built_Pa < kiss_Pa)) {
-        built_Pa = target_Pa + (built_Pa - target_Pa) * element->vfs_decay;
-        n++;
-    }
-    return (n < n_max) ? ((float)n * dt_s) : cal->fill_pulse_time_s;
-}
-
 /* Every shift's reduced model with the shift calibration (in the state's
  * copy, not on the stack: 244 B), and which shifts have both equivalent
  * clutches within the limits (tx->runnable; the others are refused with
@@ -117,9 +90,6 @@ wc_transmission_error_t wc_transmission_init(wc_transmission_t *tx, const wc_tra
     }
     const wc_transmission_error_t shifts = check_shifts(tx, config);
     if (shifts != WC_TRANSMISSION_OK) { return shifts; }
-    for (uint32_t e = 0u; e < g->element_count; ++e) {
-        tx->fill_pulse_s[e] = fill_pulse_to_kiss_s(config->shift, &tx->element[e].model);
-    }
     if (!wc_in_range(config->holding_margin_factor, 1.0f, HOLDING_MARGIN_MAX) ||
         !wc_in_range(config->holding_floor_Nm, 0.0f, HOLDING_FLOOR_MAX_Nm)) {
         return WC_TRANSMISSION_HOLDING;
@@ -156,7 +126,6 @@ static void start_shift(wc_transmission_t *tx, const wc_transmission_config_t *c
     /* mirrored: the tip-out (the kickdown's controller with the speeds and torques negated, DESIGN 15) */
     tx->sign = (tx->type == (uint32_t)WC_SHIFT_TYPE_POWER_OFF_UP) ? -1.0f : 1.0f;
     (void)wc_gearbox_shift_calibration(config->shift, row, &tx->shift_cal);
-    tx->shift_cal.fill_pulse_time_s = tx->fill_pulse_s[row->oncoming];
     make_equivalent(config->element[row->oncoming], row->oncoming_slip_scale, &tx->equivalent[0]);
     make_equivalent(config->element[row->offgoing], row->offgoing_slip_scale, &tx->equivalent[1]);
     wc_model_set_geometry(&tx->element[row->oncoming].model, &tx->equivalent[0]);
