@@ -402,7 +402,8 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
      * drives, T_t0 > 0 (the pedal pressed, or the open converter's creep while braking to a stop), runs the
      * turbine up past synchronism once the off-going element has let go, as a kickdown's: the slip past it is
      * positive (8-speed 2->1 at 5 km/h, brake 700 N m, creep 33 N m: held only against a drag, the turbine
-     * ran 560 rpm past and the lock-up failed) */
+     * ran 560 rpm past and the lock-up failed). The coast's correction takes |slip|: the clutch's torque works
+     * against its slip on either side, so more of it closes the slip either way) */
     const float past_signed_rad_s = engine ? fabsf(slip_rad_s) : slip_rad_s;
     const float past_rad_s = (past_signed_rad_s > 0.0f) ? past_signed_rad_s : 0.0f;
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
