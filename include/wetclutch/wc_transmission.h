@@ -52,7 +52,10 @@ typedef struct {
     const wc_calibration_t *element[WC_GEARBOX_ELEMENTS_MAX];  /* each element's own clutch (pack, piston, spring, VFS) */
     const wc_shift_calibration_t *shift;  /* phases, gains, fill, engine, fallback; coordinator 1; its driveline
                                            * model is each shift's (wc_gearbox_shift_calibration) */
-    float holding_margin_factor;          /* in a gear: request = |holding_torque_per_Nm x T_t| x this, in [1, 5] */
+    float holding_margin_factor;          /* in a gear: request = |holding_torque_per_Nm x T_t| x this, in [1, 5];
+                                           * the element's locked inverse adds its own holding_margin on top
+                                           * (the 8HP's tools: 1.3 x 1.2 = 1.56 x the need; at 20 degC the
+                                           * open elements' drag leaves A in 7th 1.22 in truth) */
     float holding_floor_Nm;               /* ... and at least this, in [0, 1e4] */
 } wc_transmission_config_t;
 
