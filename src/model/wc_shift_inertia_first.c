@@ -396,16 +396,12 @@ static requests_t phase_requests(wc_shift_t *shift, const wc_shift_calibration_t
     const float hold_Nm = cal->holding_torque_factor * oncoming_carried_Nm(cal, t_t_Nm);
     const float x = (phase == (uint32_t)WC_SHIFT_TORQUE) ? handover_share(shift, cal, dt_s) : 1.0f;
     /* the turbine running past synchronism (slip > 0: the off-going clutch lets go while T_t still drives) is
-     * taken by the on-coming clutch in closed loop (the torque-first shift's flare correction, DESIGN 14) */
-    /* (after a coast downshift T_t < 0 drags the turbine back below synchronism: the slip past it is
-     * negative, and the on-coming clutch holds it the same way; a coast downshift requested while the engine
-     * drives, T_t0 > 0 (the pedal pressed, or the open converter's creep while braking to a stop), runs the
-     * turbine up past synchronism once the off-going element has let go, as a kickdown's: the slip past it is
-     * positive (8-speed 2->1 at 5 km/h, brake 700 N m, creep 33 N m: held only against a drag, the turbine
-     * ran 560 rpm past and the lock-up failed). The coast's correction takes |slip|: the clutch's torque works
-     * against its slip on either side, so more of it closes the slip either way) */
-    const float past_signed_rad_s = engine ? fabsf(slip_rad_s) : slip_rad_s;
-    const float past_rad_s = (past_signed_rad_s > 0.0f) ? past_signed_rad_s : 0.0f;
+     * taken by the on-coming clutch in closed loop (the torque-first shift's flare correction, DESIGN 14). The
+     * coast downshift's turbine may pass it either way: dragged back below by T_t < 0, or run up past it by an
+     * engine that drives (T_t0 > 0: a pressed pedal, the open converter's creep while braking to a stop; the
+     * 8-speed's 2->1 at 5 km/h, brake 700 N m, creep 33 N m: corrected one way only, it ran 560 rpm past and
+     * the lock-up failed). The clutch's torque works against its slip on either side: |slip| */
+    const float past_rad_s = engine ? fabsf(slip_rad_s) : ((slip_rad_s > 0.0f) ? slip_rad_s : 0.0f);
     if (phase == (uint32_t)WC_SHIFT_TORQUE) {
         const float integral_Nm = shift->flare_integral_Nm + cal->flare_ki_Nm_per_rad * past_rad_s * dt_s;
         /* anti-windup: |T_t| beyond what the clutch carries already. |T_t| alone: a cold coast downshift's

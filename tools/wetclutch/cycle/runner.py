@@ -245,7 +245,6 @@ def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: f
     k_lift = None
     cpu0 = time.process_time()
     o = None
-    q_res = v.slip_resolution
     for k in range(n):
         t = t0 + k * DT_S
         if k % DRIVER_PERIOD == 0:
@@ -279,8 +278,7 @@ def run_cycle(vehicle="nominal", trace: SpeedTrace | None = None, *, oil_degC: f
             if progress is not None and k % 1000 == 0:
                 progress(t)
         z = rng.standard_normal(3)
-        w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q_res) * q_res * RPM
-        w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q_res) * q_res * RPM
+        w_t, w_o = transmission8.measured_speeds_rad_s(v, st, z)
         torque_est = _turbine_torque_estimate(st, v.torque_estimate_bias, v.torque_estimate_noise * z[2])
         if request is not None:
             kind_now = window.kind

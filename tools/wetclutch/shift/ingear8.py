@@ -62,7 +62,7 @@ from ..simulate.gearbox_plant import Plant8
 from .matrix8 import LOCKUP_MA, RPM, _plant_and_models, plant_path
 from .scenarios import ShiftError
 from .transmission8 import (ELEMENTS, HOLDING_FLOOR_NM, HOLDING_MARGIN, SCENARIOS, TCU_VEHICLE, Transmission,
-                            _library)
+                            _library, measured_speeds_rad_s)
 
 SLIP_LIMIT_RPM = 5.0                 # issue 29: no closed element slips more than 5 rpm in a gear
 RPM_HOLD = SCENARIOS["power-on upshift"][2]      # 2500 rpm: full load available (the plateau 1500..4500)
@@ -135,12 +135,10 @@ def hold_gear(vehicle, gear: int, oil_degC: float, *, rpm: float = RPM_HOLD, set
     cals = {e: gb.element(e).calibration for e in closed}
     lib = lib or _library()
     rng = np.random.default_rng(seed)
-    q = v.slip_resolution
 
     def measure(st):
         z = rng.standard_normal(4)
-        w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q) * q * RPM
-        w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q) * q * RPM
+        w_t, w_o = measured_speeds_rad_s(v, st, z)
         return w_t, w_o, st["engine_torque_Nm"] * (1.0 + v.torque_estimate_bias) + v.torque_estimate_noise * z[2]
 
     # the TCU's holding currents on the initial state, then the plant in steady state at them

@@ -293,9 +293,7 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
     lost_from, lost_periods = None, (int(round(fault[2] / dt)) if fault is not None else 0)
     for k in range(n_max):
         z = rng.standard_normal(4)
-        q = v.slip_resolution
-        w_t = round((st["turbine_speed_rpm"] + v.slip_noise * z[0]) / q) * q * RPM
-        w_o = round((st["output_speed_rpm"] + v.slip_noise * z[1]) / q) * q * RPM
+        w_t, w_o = measured_speeds_rad_s(v, st, z)
         torque = st["engine_torque_Nm"] * (1.0 + v.torque_estimate_bias) + v.torque_estimate_noise * z[2]
         lost = lost_from is not None and lost_from <= k < lost_from + lost_periods
         if lost:
@@ -327,6 +325,15 @@ def _simulate(vehicle, source, target, kind, load, oil_degC, seed, lib, keep_tcu
     tcu = dict(zip(TCU_CHANNELS, np.array(tcu_rows, dtype=float).T)) if tcu_rows else {}
     lost = (lost_from, lost_from + lost_periods) if lost_from is not None else None
     return ShiftTrace(quality, truth, tcu, n_pre, end_k, (ratio_src, ratio_tgt), on, off, lost)
+
+
+def measured_speeds_rad_s(vehicle, state, z) -> tuple[float, float]:
+    """The TCU's turbine and output speed, rad/s: the plant's (state, rpm) with the vehicle file's sensor noise
+    (slip_noise x the standard normals z[0], z[1]) in the bus's steps (slip_resolution, rpm); the one sensor model
+    of the 8-speed's runs (the matrix, the in-gear hold, the drive cycle)."""
+    q = vehicle.slip_resolution
+    return (round((state["turbine_speed_rpm"] + vehicle.slip_noise * z[0]) / q) * q * RPM,
+            round((state["output_speed_rpm"] + vehicle.slip_noise * z[1]) / q) * q * RPM)
 
 
 def _oncoming_index(params, src: str, tgt: str) -> int:

@@ -44,6 +44,15 @@ FILM_AT_REST = 1e-7        # relative force mismatch under which a film under a 
 _np_exp = np.exp           # bound once: the viscosity is evaluated per element every period
 
 
+def _kinetic_term(name: str) -> property:
+    """A kinetic coefficient made on demand (TrueElement._kinetic_terms), read like the attribute it was."""
+    def get(self):
+        if self._kinetic_stale:
+            self._kinetic_terms()
+        return getattr(self, name)
+    return property(get)
+
+
 class TrueElement:
     """The true clutch of one element; the mechanics read kinetic(|slip|), slope(|slip|) and static."""
 
@@ -178,29 +187,10 @@ class TrueElement:
         self._kinetic_stale = False
 
     # the coefficients for a reader outside the mechanics (as attributes before they were made on demand)
-    @property
-    def hbar(self) -> float:
-        if self._kinetic_stale:
-            self._kinetic_terms()
-        return self._hbar
-
-    @property
-    def coul_k(self) -> float:
-        if self._kinetic_stale:
-            self._kinetic_terms()
-        return self._coul_k
-
-    @property
-    def visc_c(self) -> float:
-        if self._kinetic_stale:
-            self._kinetic_terms()
-        return self._visc_c
-
-    @property
-    def aer_q(self) -> float:
-        if self._kinetic_stale:
-            self._kinetic_terms()
-        return self._aer_q
+    hbar = _kinetic_term("_hbar")
+    coul_k = _kinetic_term("_coul_k")
+    visc_c = _kinetic_term("_visc_c")
+    aer_q = _kinetic_term("_aer_q")
 
     def _force(self, p):
         f = p * self.a_p - self.f_s
